@@ -1,0 +1,144 @@
+#include "harness/camera.h"
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <stdexcept>
+
+#include "harness/errors.h"
+
+namespace tgnav::harness {
+
+namespace {
+// Vehicle geoms live in group 2 (models/quadrotor.xml); the onboard camera must not see them.
+constexpr int kVehicleGeomGroup = 2;
+
+template <typename T>
+void require(bool ok, const char* field, T value, const char* rule) {
+  if (!ok) {
+    throw std::invalid_argument(std::string(field) + " = " + std::to_string(value) + ": " + rule);
+  }
+}
+}  // namespace
+
+void CameraConfig::validate() const {
+  if (name.empty()) throw std::invalid_argument("name: must not be empty");
+  require(width_px >= 16 && width_px <= 4096, "width_px", width_px, "must be in [16, 4096]");
+  require(height_px >= 16 && height_px <= 4096, "height_px", height_px, "must be in [16, 4096]");
+  require(near_clip_m > 0.0, "near_clip_m", near_clip_m, "must be > 0");
+  require(far_clip_m > near_clip_m, "far_clip_m", far_clip_m, "must be > near_clip_m");
+  require(min_depth_m >= near_clip_m, "min_depth_m", min_depth_m, "must be >= near_clip_m");
+  require(max_depth_m > min_depth_m && max_depth_m <= far_clip_m, "max_depth_m", max_depth_m,
+          "must be in (min_depth_m, far_clip_m]");
+  require(rgb_noise_sigma >= 0.0, "rgb_noise_sigma", rgb_noise_sigma, "must be >= 0");
+  require(depth_noise_sigma_per_m2 >= 0.0, "depth_noise_sigma_per_m2", depth_noise_sigma_per_m2,
+          "must be >= 0");
+}
+
+Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px) {
+  Intrinsics k;
+  k.width_px = width_px;
+  k.height_px = height_px;
+  k.fy = 0.5 * height_px / std::tan(0.5 * fovy_deg * M_PI / 180.0);
+  k.fx = k.fy;
+  // OpenGL's image centre lies between pixels; OpenCV puts pixel centres on integers.
+  k.cx = 0.5 * (width_px - 1);
+  k.cy = 0.5 * (height_px - 1);
+  return k;
+}
+
+Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed)
+    : model_(m), gl_(gl), config_(config), rng_(seed) {
+  config_.validate();
+  cam_id_ = mj_name2id(m, mjOBJ_CAMERA, config_.name.c_str());
+  if (cam_id_ < 0) throw InputError("camera '" + config_.name + "' is not in the model");
+
+  m->vis.global.offwidth = std::max(m->vis.global.offwidth, config_.width_px);
+  m->vis.global.offheight = std::max(m->vis.global.offheight, config_.height_px);
+  m->vis.map.znear = static_cast<float>(config_.near_clip_m / m->stat.extent);
+  m->vis.map.zfar = static_cast<float>(config_.far_clip_m / m->stat.extent);
+  // What OpenGL will actually use (float precision of vis.map included).
+  near_m_ = m->vis.map.znear * m->stat.extent;
+  far_m_ = m->vis.map.zfar * m->stat.extent;
+  intrinsics_ = intrinsicsFromFovy(m->cam_fovy[cam_id_], config_.width_px, config_.height_px);
+
+  gl_.makeCurrent();
+  mjv_defaultCamera(&view_);
+  view_.type = mjCAMERA_FIXED;
+  view_.fixedcamid = cam_id_;
+  mjv_defaultOption(&option_);
+  option_.geomgroup[kVehicleGeomGroup] = 0;
+  mjv_defaultScene(&scene_);
+  mjv_makeScene(m, &scene_, 2000);
+  scene_.flags[mjRND_SHADOW] = 0;
+  scene_.flags[mjRND_REFLECTION] = 0;
+  scene_.flags[mjRND_SKYBOX] = 0;
+  mjr_defaultContext(&context_);
+  mjr_makeContext(m, &context_, mjFONTSCALE_100);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  if (context_.currentBuffer != mjFB_OFFSCREEN) {
+    throw std::runtime_error("MuJoCo: offscreen framebuffer unavailable in this GL context");
+  }
+  rgb_buffer_.resize(3 * static_cast<std::size_t>(config_.width_px) * config_.height_px);
+  depth_buffer_.resize(static_cast<std::size_t>(config_.width_px) * config_.height_px);
+}
+
+Camera::~Camera() {
+  gl_.makeCurrent();
+  mjr_freeContext(&context_);
+  mjv_freeScene(&scene_);
+}
+
+Eigen::Isometry3d Camera::pose(const mjData* d) const {
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d R_W_mj;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R_W_mj(r, c) = d->cam_xmat[9 * cam_id_ + 3 * r + c];
+  }
+  // MuJoCo camera (x right, y up, z backward) -> vision camera (x right, y down, z forward).
+  X_WC.linear() = R_W_mj * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  X_WC.translation() = Eigen::Vector3d(d->cam_xpos[3 * cam_id_], d->cam_xpos[3 * cam_id_ + 1],
+                                       d->cam_xpos[3 * cam_id_ + 2]);
+  return X_WC;
+}
+
+RgbdFrame Camera::render(mjData* d) {
+  gl_.makeCurrent();
+  const int w = config_.width_px;
+  const int h = config_.height_px;
+  mjv_updateScene(model_, d, &option_, nullptr, &view_, mjCAT_ALL, &scene_);
+  // Several cameras may share one GL context: bind this camera's framebuffer every time.
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  const mjrRect viewport = {0, 0, w, h};
+  mjr_render(viewport, &scene_, &context_);
+  mjr_readPixels(rgb_buffer_.data(), depth_buffer_.data(), viewport, &context_);
+
+  RgbdFrame frame;
+  frame.t_s = d->time;
+  frame.X_WC = pose(d);
+  frame.bgr.create(h, w, CV_8UC3);
+  frame.depth_m.create(h, w, CV_32FC1);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  const bool rgb_noise = config_.rgb_noise_sigma > 0.0;
+  const bool depth_noise = config_.depth_noise_sigma_per_m2 > 0.0;
+  // OpenGL rows run bottom-up; images run top-down.
+  for (int row = 0; row < h; ++row) {
+    const std::size_t src_row = static_cast<std::size_t>(h - 1 - row) * w;
+    auto* bgr = frame.bgr.ptr<cv::Vec3b>(row);
+    auto* depth = frame.depth_m.ptr<float>(row);
+    for (int col = 0; col < w; ++col) {
+      const unsigned char* rgb = &rgb_buffer_[3 * (src_row + col)];
+      for (int ch = 0; ch < 3; ++ch) {
+        double value = rgb[2 - ch];
+        if (rgb_noise) value += config_.rgb_noise_sigma * unit(rng_);
+        bgr[col][ch] = cv::saturate_cast<unsigned char>(value);
+      }
+      double z = linearizeDepth(depth_buffer_[src_row + col], near_m_, far_m_);
+      if (depth_noise) z += config_.depth_noise_sigma_per_m2 * z * z * unit(rng_);
+      depth[col] = (z >= config_.min_depth_m && z <= config_.max_depth_m) ? static_cast<float>(z)
+                                                                           : 0.0f;
+    }
+  }
+  return frame;
+}
+
+}  // namespace tgnav::harness

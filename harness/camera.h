@@ -1,0 +1,95 @@
+#pragma once
+// Forward RGB-D camera rendered offscreen by MuJoCo through an EGL context.
+//
+// Camera frame C follows the computer-vision convention (x right, y down, z forward along the
+// optical axis); MuJoCo's own camera frame (x right, y up, looking along -z) is converted here
+// and nowhere else. Pixel (u, v) = (column, row) with the origin at the centre of the top-left
+// pixel, as in OpenCV.
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <random>
+#include <string>
+
+#include "harness/egl_context.h"
+
+namespace tgnav::harness {
+
+struct CameraConfig {
+  std::string name = "front";  // MJCF camera name
+  int width_px = 640;
+  int height_px = 480;
+  double near_clip_m = 0.05;   // OpenGL clipping planes
+  double far_clip_m = 40.0;
+  double min_depth_m = 0.1;    // depth outside [min, max] is reported invalid (0)
+  double max_depth_m = 10.0;
+  double rgb_noise_sigma = 0.0;              // Gaussian pixel noise, 8-bit intensity units
+  double depth_noise_sigma_per_m2 = 0.0;     // depth noise sigma = k z^2 (structured light)
+
+  // Throws std::invalid_argument naming the field and value.
+  void validate() const;
+};
+
+struct Intrinsics {
+  int width_px = 0;
+  int height_px = 0;
+  double fx = 0.0;
+  double fy = 0.0;
+  double cx = 0.0;
+  double cy = 0.0;
+};
+
+struct RgbdFrame {
+  double t_s = 0.0;
+  cv::Mat bgr;      // CV_8UC3, OpenCV channel order
+  cv::Mat depth_m;  // CV_32FC1, z along the optical axis in metres; 0 = invalid
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+};
+
+class Camera {
+ public:
+  // Makes `gl` current and allocates MuJoCo's render context. Writes the offscreen buffer
+  // size and clipping planes this camera needs into m->vis (MuJoCo reads them from there).
+  Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed);
+  ~Camera();
+  Camera(const Camera&) = delete;
+  Camera& operator=(const Camera&) = delete;
+  Camera(Camera&&) = delete;
+  Camera& operator=(Camera&&) = delete;
+
+  // Renders the current state of `d` (kinematics must be up to date, e.g. after mj_step).
+  RgbdFrame render(mjData* d);
+  // Pose of C in W for the current state of `d`.
+  Eigen::Isometry3d pose(const mjData* d) const;
+  const Intrinsics& intrinsics() const { return intrinsics_; }
+  int cameraId() const { return cam_id_; }
+
+ private:
+  const mjModel* model_;
+  const EglContext& gl_;
+  CameraConfig config_;
+  Intrinsics intrinsics_;
+  int cam_id_ = -1;
+  double near_m_ = 0.0;
+  double far_m_ = 0.0;
+  mjvScene scene_{};
+  mjvCamera view_{};
+  mjvOption option_{};
+  mjrContext context_{};
+  std::vector<unsigned char> rgb_buffer_;
+  std::vector<float> depth_buffer_;
+  std::mt19937_64 rng_;
+};
+
+// Intrinsics of a pinhole camera with vertical field of view `fovy_deg` and square pixels,
+// which is what MuJoCo renders.
+Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px);
+
+// Converts an OpenGL depth-buffer value in [0, 1] to metric z for the given clip planes.
+inline double linearizeDepth(double buffer, double near_m, double far_m) {
+  return near_m / (1.0 - buffer * (1.0 - near_m / far_m));
+}
+
+}  // namespace tgnav::harness

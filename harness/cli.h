@@ -1,0 +1,16 @@
+#pragma once
+// Subcommands of the `tgnav` program. Each registers itself on the app; its callback throws
+// InputError for bad input (exit 2) and anything else for internal failures (exit 1).
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace tgnav::cli {
+
+void addRenderCommand(CLI::App& app);
+
+// Parses "a,b,c" into exactly `count` finite numbers; InputError naming `option` otherwise.
+std::vector<double> parseNumbers(const std::string& text, std::size_t count,
+                                 const std::string& option, const std::string& form);
+
+}  // namespace tgnav::cli

@@ -1,0 +1,64 @@
+// tgnav: headless closed-loop harness for topology-guided perception-aware MAV navigation.
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+
+#include "harness/cli.h"
+#include "harness/errors.h"
+
+namespace tgnav::cli {
+
+std::vector<double> parseNumbers(const std::string& text, std::size_t count,
+                                 const std::string& option, const std::string& form) {
+  std::vector<double> values;
+  std::stringstream ss(text);
+  std::string item;
+  bool ok = true;
+  while (ok && std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    try {
+      const double v = std::stod(item, &used);
+      ok = used == item.size() && std::isfinite(v);
+      values.push_back(v);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+  }
+  if (!ok || values.size() != count || (!text.empty() && text.back() == ',')) {
+    throw InputError(option + ": '" + text + "' is not " + form);
+  }
+  return values;
+}
+
+}  // namespace tgnav::cli
+
+namespace {
+// Errors are one line: library messages (MuJoCo's, yaml-cpp's) may span several.
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) {
+    text.replace(i, 1, "; ");
+  }
+  return text;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
+  app.require_subcommand(1);
+  tgnav::cli::addRenderCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  } catch (const tgnav::InputError& e) {
+    std::fprintf(stderr, "tgnav: error: %s\n", oneLine(e.what()).c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tgnav: internal error: %s\n", oneLine(e.what()).c_str());
+    return 1;
+  }
+  return 0;
+}

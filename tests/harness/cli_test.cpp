@@ -1,0 +1,111 @@
+// The tgnav program's contract: exit 0 and complete outputs on success; exit 2 with a one-line
+// error naming the file, key or value on bad input, and no output written.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+
+#include "test_util.h"
+
+namespace tgnav {
+namespace {
+
+struct CmdResult {
+  int rc = -1;
+  std::string output;  // stdout and stderr
+};
+
+CmdResult tgnav(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + " " + TGNAV_BIN + " " + args + " 2>&1";
+  CmdResult run;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
+  const int status = pclose(pipe);
+  run.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string smoke() { return (test::sourceDir() / "configs/scenes/smoke.yaml").string(); }
+
+int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST(CliRender, WritesImagesAndIntrinsics) {
+  const auto out = test::tempDir() / "out";
+  const CmdResult run = tgnav("render --scene " + smoke() + " --pose 1.2,0.2,1,0 --width 320 --height 240 --out " +
+                        out.string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  const cv::Mat rgb = cv::imread((out / "rgb.png").string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat depth = cv::imread((out / "depth.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(rgb.type(), CV_8UC3);
+  EXPECT_EQ(rgb.cols, 320);
+  EXPECT_EQ(rgb.rows, 240);
+  ASSERT_EQ(depth.type(), CV_16UC1);
+  // Facing the east crates from 2.2 m: the centre depth is a plausible millimetre value.
+  const int centre_mm = depth.at<uint16_t>(120, 160);
+  EXPECT_GT(centre_mm, 1500);
+  EXPECT_LT(centre_mm, 3000);
+  EXPECT_TRUE(std::filesystem::is_regular_file(out / "intrinsics.yaml"));
+  for (const auto& entry : std::filesystem::directory_iterator(out)) {
+    EXPECT_NE(entry.path().extension(), ".tmp") << "temporary file left behind";
+  }
+}
+
+TEST(CliRender, BadPoseIsOneLineExit2AndWritesNothing) {
+  const auto out = test::tempDir() / "out";
+  const CmdResult run = tgnav("render --scene " + smoke() + " --pose 1,2,x,0 --out " + out.string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("--pose: '1,2,x,0'"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliRender, MissingSceneNamesTheFile) {
+  const CmdResult run = tgnav("render --scene /nonexistent/scene.yaml --out " + (test::tempDir() / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("/nonexistent/scene.yaml"), std::string::npos) << run.output;
+}
+
+TEST(CliRender, InvalidMjcfNamesTheFile) {
+  const auto dir = test::tempDir();
+  const auto bad = test::writeFile(dir / "bad.xml", "<mujoco><worldbody><geom type='nope'/></worldbody></mujoco>");
+  const CmdResult run = tgnav("render --scene " + bad.string() + " --pose 0,0,1,0 --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(bad.string() + ": invalid MJCF"), std::string::npos) << run.output;
+}
+
+TEST(CliRender, MjcfWithoutVehicleIsRejected) {
+  const auto dir = test::tempDir();
+  const auto xml = test::writeFile(dir / "empty.xml", "<mujoco/>");
+  const CmdResult run = tgnav("render --scene " + xml.string() + " --pose 0,0,1,0 --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("body 'quadrotor'"), std::string::npos) << run.output;
+}
+
+TEST(CliRender, BadResolutionNamesTheValue) {
+  const CmdResult run = tgnav("render --scene " + smoke() + " --width -5 --out " + (test::tempDir() / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("width_px = -5"), std::string::npos) << run.output;
+}
+
+TEST(CliRender, MissingEglSaysWhatToInstall) {
+  const CmdResult run = tgnav("render --scene " + smoke() + " --out " + (test::tempDir() / "o").string(),
+                        "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json");
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("install libegl1 libegl-mesa0 libgl1-mesa-dri"), std::string::npos)
+      << run.output;
+}
+
+TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
+  EXPECT_EQ(tgnav("fly-to-the-moon").rc, 2);
+  EXPECT_EQ(tgnav("--help").rc, 0);
+  EXPECT_EQ(tgnav("render --help").rc, 0);
+}
+
+}  // namespace
+}  // namespace tgnav

@@ -1,0 +1,40 @@
+#pragma once
+// ORB features spread over the image on a grid (ORB-SLAM2's bucketing idea): a textured patch
+// in one corner must not starve the rest of the image of features.
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <vector>
+
+namespace tgnav::vo {
+
+struct FeatureConfig {
+  int max_features = 1000;
+  int grid_cols = 8;
+  int grid_rows = 6;
+  int fast_threshold = 20;   // FAST intensity threshold (8-bit units), ORB-SLAM2's iniThFAST
+  double scale_factor = 1.2;
+  int pyramid_levels = 8;
+  int edge_threshold_px = 19;
+
+  // Throws std::invalid_argument naming the field and value.
+  void validate() const;
+};
+
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  // one 32-byte ORB row per keypoint
+};
+
+class FeatureDetector {
+ public:
+  explicit FeatureDetector(const FeatureConfig& config);
+  // `gray` is CV_8UC1. Each grid cell keeps its strongest keypoints up to an equal share of
+  // max_features; budget a cell cannot use goes to the strongest keypoints left anywhere.
+  Features detect(const cv::Mat& gray) const;
+
+ private:
+  FeatureConfig config_;
+  cv::Ptr<cv::ORB> orb_;
+};
+
+}  // namespace tgnav::vo
