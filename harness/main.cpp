@@ -47,6 +47,9 @@ std::string oneLine(std::string text) {
 int main(int argc, char** argv) {
   CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
   app.require_subcommand(1);
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "tgnav: error: " + std::string(e.what()) + " (see --help)\n";
+  });
   tgnav::cli::addRenderCommand(app);
   try {
     app.parse(argc, argv);

@@ -102,7 +102,12 @@ TEST(CliRender, MissingEglSaysWhatToInstall) {
 }
 
 TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
-  EXPECT_EQ(tgnav("fly-to-the-moon").rc, 2);
+  const CmdResult bad = tgnav("fly-to-the-moon");
+  EXPECT_EQ(bad.rc, 2);
+  EXPECT_EQ(lines(bad.output), 1) << bad.output;
+  const CmdResult missing = tgnav("render --scene x.yaml");
+  EXPECT_EQ(missing.rc, 2);
+  EXPECT_NE(missing.output.find("--out is required"), std::string::npos) << missing.output;
   EXPECT_EQ(tgnav("--help").rc, 0);
   EXPECT_EQ(tgnav("render --help").rc, 0);
 }
