@@ -88,14 +88,26 @@ Camera::~Camera() {
   mjv_freeScene(&scene_);
 }
 
+namespace {
+// MuJoCo camera (x right, y up, z backward) -> vision camera (x right, y down, z forward).
+Eigen::Matrix3d mujocoToVision() { return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal(); }
+}  // namespace
+
+Eigen::Isometry3d cameraInBody(const mjModel* m, int cam_id) {
+  const mjtNum* q = m->cam_quat + 4 * cam_id;
+  Eigen::Isometry3d X_BC = Eigen::Isometry3d::Identity();
+  X_BC.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix() * mujocoToVision();
+  X_BC.translation() = Eigen::Vector3d(m->cam_pos + 3 * cam_id);
+  return X_BC;
+}
+
 Eigen::Isometry3d Camera::pose(const mjData* d) const {
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
   Eigen::Matrix3d R_W_mj;
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) R_W_mj(r, c) = d->cam_xmat[9 * cam_id_ + 3 * r + c];
   }
-  // MuJoCo camera (x right, y up, z backward) -> vision camera (x right, y down, z forward).
-  X_WC.linear() = R_W_mj * Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+  X_WC.linear() = R_W_mj * mujocoToVision();
   X_WC.translation() = Eigen::Vector3d(d->cam_xpos[3 * cam_id_], d->cam_xpos[3 * cam_id_ + 1],
                                        d->cam_xpos[3 * cam_id_ + 2]);
   return X_WC;

@@ -83,6 +83,9 @@ class Camera {
   std::mt19937_64 rng_;
 };
 
+// Pose of camera `cam_id` in its parent body's frame (vision convention), fixed by the model.
+Eigen::Isometry3d cameraInBody(const mjModel* m, int cam_id);
+
 // Intrinsics of a pinhole camera with vertical field of view `fovy_deg` and square pixels,
 // which is what MuJoCo renders.
 Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px);

@@ -8,22 +8,6 @@
 namespace tgnav::harness {
 
 namespace {
-void readOptional(const YamlDoc& doc, const YAML::Node& map, const std::string& key, double& out) {
-  if (map[key]) out = doc.number(map, key, "");
-}
-void readOptional(const YamlDoc& doc, const YAML::Node& map, const std::string& key, int& out) {
-  if (!map[key]) return;
-  const double v = doc.number(map, key, "");
-  if (v != static_cast<int>(v)) {
-    doc.fail(map[key], "key '" + key + "' has value '" + map[key].Scalar() + "', expected an integer");
-  }
-  out = static_cast<int>(v);
-}
-void readOptional(const YamlDoc& doc, const YAML::Node& map, const std::string& key,
-                  std::string& out) {
-  if (map[key]) out = doc.string(map, key, "");
-}
-
 template <typename Config>
 void validateFrom(const YamlDoc& doc, const Config& config) {
   try {
@@ -34,24 +18,80 @@ void validateFrom(const YamlDoc& doc, const Config& config) {
 }
 }  // namespace
 
-CameraConfig loadCameraConfig(const std::filesystem::path& yaml, CameraConfig base) {
+CameraConfig loadCameraConfig(const std::filesystem::path& yaml, CameraConfig c) {
   const YamlDoc doc = YamlDoc::load(yaml);
-  const YAML::Node& root = doc.root();
-  doc.requireKeys(root,
-                  {"name", "width_px", "height_px", "near_clip_m", "far_clip_m", "min_depth_m",
-                   "max_depth_m", "rgb_noise_sigma", "depth_noise_sigma_per_m2"},
-                  "");
-  readOptional(doc, root, "name", base.name);
-  readOptional(doc, root, "width_px", base.width_px);
-  readOptional(doc, root, "height_px", base.height_px);
-  readOptional(doc, root, "near_clip_m", base.near_clip_m);
-  readOptional(doc, root, "far_clip_m", base.far_clip_m);
-  readOptional(doc, root, "min_depth_m", base.min_depth_m);
-  readOptional(doc, root, "max_depth_m", base.max_depth_m);
-  readOptional(doc, root, "rgb_noise_sigma", base.rgb_noise_sigma);
-  readOptional(doc, root, "depth_noise_sigma_per_m2", base.depth_noise_sigma_per_m2);
-  validateFrom(doc, base);
-  return base;
+  FieldReader(doc, doc.root(), "")
+      .read("name", c.name)
+      .read("width_px", c.width_px)
+      .read("height_px", c.height_px)
+      .read("near_clip_m", c.near_clip_m)
+      .read("far_clip_m", c.far_clip_m)
+      .read("min_depth_m", c.min_depth_m)
+      .read("max_depth_m", c.max_depth_m)
+      .read("rgb_noise_sigma", c.rgb_noise_sigma)
+      .read("depth_noise_sigma_per_m2", c.depth_noise_sigma_per_m2)
+      .finish();
+  validateFrom(doc, c);
+  return c;
+}
+
+control::CascadeConfig loadCascadeConfig(const std::filesystem::path& yaml, control::CascadeConfig c) {
+  const YamlDoc doc = YamlDoc::load(yaml);
+  FieldReader(doc, doc.root(), "")
+      .section("rates_hz",
+               [&](FieldReader r) {
+                 r.read("position", c.position_rate_hz)
+                     .read("attitude", c.attitude_rate_hz)
+                     .read("rate", c.rate_rate_hz)
+                     .finish();
+               })
+      .section("position",
+               [&](FieldReader r) {
+                 auto& p = c.position;
+                 r.read("pos_p_xy", p.pos_p_xy)
+                     .read("pos_p_z", p.pos_p_z)
+                     .read("vel_p_xy", p.vel_p_xy)
+                     .read("vel_i_xy", p.vel_i_xy)
+                     .read("vel_d_xy", p.vel_d_xy)
+                     .read("vel_p_z", p.vel_p_z)
+                     .read("vel_i_z", p.vel_i_z)
+                     .read("vel_d_z", p.vel_d_z)
+                     .read("max_vel_xy_m_s", p.max_vel_xy_m_s)
+                     .read("max_vel_up_m_s", p.max_vel_up_m_s)
+                     .read("max_vel_down_m_s", p.max_vel_down_m_s)
+                     .read("tilt_max_rad", p.tilt_max_rad)
+                     .read("thrust_min", p.thrust_min)
+                     .read("thrust_max", p.thrust_max)
+                     .read("thrust_xy_margin", p.thrust_xy_margin)
+                     .read("vel_deriv_cutoff_hz", p.vel_deriv_cutoff_hz)
+                     .finish();
+               })
+      .section("attitude",
+               [&](FieldReader r) {
+                 auto& a = c.attitude;
+                 r.read("roll_p", a.roll_p)
+                     .read("pitch_p", a.pitch_p)
+                     .read("yaw_p", a.yaw_p)
+                     .read("yaw_weight", a.yaw_weight)
+                     .read("max_roll_rate_rad_s", a.max_roll_rate_rad_s)
+                     .read("max_pitch_rate_rad_s", a.max_pitch_rate_rad_s)
+                     .read("max_yaw_rate_rad_s", a.max_yaw_rate_rad_s)
+                     .finish();
+               })
+      .section("rate",
+               [&](FieldReader r) {
+                 auto& g = c.rate;
+                 r.read("p", g.p)
+                     .read("i", g.i)
+                     .read("d", g.d)
+                     .read("ff", g.ff)
+                     .read("integrator_limit", g.integrator_limit)
+                     .read("dterm_cutoff_hz", g.dterm_cutoff_hz)
+                     .finish();
+               })
+      .finish();
+  validateFrom(doc, c);
+  return c;
 }
 
 }  // namespace tgnav::harness

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <mutex>
+#include <Eigen/Geometry>
 #include <stdexcept>
 
 #include "harness/errors.h"
@@ -90,5 +91,49 @@ void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const pl
 }
 
 double vehicleMass(const mjModel* m, const VehicleIds& ids) { return m->body_subtreemass[ids.body]; }
+
+control::VehicleParams vehicleParamsFromModel(const mjModel* m, const VehicleIds& ids) {
+  control::VehicleParams v;
+  v.mass_kg = vehicleMass(m, ids);
+  v.inertia_diag_kg_m2 = Eigen::Vector3d(m->body_inertia + 3 * ids.body);
+  v.gravity_m_s2 = -m->opt.gravity[2];
+  const Eigen::Vector3d com_B(m->body_ipos + 3 * ids.body);
+  for (int i = 0; i < 4; ++i) {
+    const int a = ids.motors[i];
+    const int site = m->actuator_trnid[2 * a];
+    if (m->actuator_trntype[a] != mjTRN_SITE || m->site_bodyid[site] != ids.body) {
+      throw InputError("actuator 'motor" + std::to_string(i) + "' must act on a site of body 'quadrotor'");
+    }
+    const Eigen::Quaterniond q_BS(m->site_quat[4 * site], m->site_quat[4 * site + 1],
+                                  m->site_quat[4 * site + 2], m->site_quat[4 * site + 3]);
+    const Eigen::Vector3d force = q_BS * Eigen::Vector3d(m->actuator_gear + 6 * a);
+    const Eigen::Vector3d moment = q_BS * Eigen::Vector3d(m->actuator_gear + 6 * a + 3);
+    control::Rotor r;
+    r.p_B = Eigen::Vector3d(m->site_pos + 3 * site) - com_B;
+    r.axis_B = force.normalized();
+    r.spin = moment.dot(r.axis_B) <= 0.0 ? 1 : -1;  // drag reacts against the spin
+    r.yaw_moment_ratio_m = moment.norm() / force.norm();
+    r.max_thrust_n = m->actuator_ctrlrange[2 * a + 1] * m->actuator_gainprm[a * mjNGAIN] * force.norm();
+    v.rotors.push_back(r);
+    v.motor_time_constant_s = m->actuator_dynprm[a * mjNDYN];
+  }
+  try {
+    v.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("vehicle model: ") + e.what());
+  }
+  return v;
+}
+
+control::VehicleState vehicleState(const mjData* d, const VehicleIds& ids) {
+  control::VehicleState s;
+  const mjtNum* q = d->qpos + ids.qpos_adr;
+  const mjtNum* v = d->qvel + ids.qvel_adr;
+  s.p_WB = Eigen::Vector3d(q[0], q[1], q[2]);
+  s.q_WB = Eigen::Quaterniond(q[3], q[4], q[5], q[6]).normalized();
+  s.v_WB = Eigen::Vector3d(v[0], v[1], v[2]);
+  s.w_B = Eigen::Vector3d(v[3], v[4], v[5]);
+  return s;
+}
 
 }  // namespace tgnav::harness

@@ -7,6 +7,8 @@
 #include <memory>
 #include <string>
 
+#include "control/types.h"
+#include "control/vehicle.h"
 #include "planner/pose4.h"
 
 namespace tgnav::harness {
@@ -50,5 +52,13 @@ void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const pl
 
 // Total mass of the vehicle's body subtree in kg.
 double vehicleMass(const mjModel* m, const VehicleIds& ids);
+
+// Mass, inertia and rotor geometry as the model defines them: rotor positions from the
+// actuator sites (relative to the centre of mass), thrust axes and yaw-moment ratios from the
+// actuator gears, maximum thrust from the control ranges, motor lag from the filter constant.
+control::VehicleParams vehicleParamsFromModel(const mjModel* m, const VehicleIds& ids);
+
+// True state of the vehicle (free-joint position/velocity, body rates).
+control::VehicleState vehicleState(const mjData* d, const VehicleIds& ids);
 
 }  // namespace tgnav::harness

@@ -103,4 +103,45 @@ std::vector<double> YamlDoc::numbers(const YAML::Node& map, const std::string& k
   return out;
 }
 
+FieldReader::FieldReader(const YamlDoc& doc, YAML::Node map, std::string context)
+    : doc_(doc), map_(std::move(map)), context_(std::move(context)) {
+  if (!map_.IsMap()) {
+    doc_.fail(map_, "'" + (context_.empty() ? std::string("<root>") : context_) + "' must be a mapping");
+  }
+}
+
+FieldReader& FieldReader::read(const std::string& key, double& out) {
+  known_.push_back(key);
+  if (map_[key]) out = doc_.number(map_, key, context_);
+  return *this;
+}
+
+FieldReader& FieldReader::read(const std::string& key, int& out) {
+  known_.push_back(key);
+  if (!map_[key]) return *this;
+  const double v = doc_.number(map_, key, context_);
+  if (v != std::floor(v) || std::abs(v) > 1e9) {
+    doc_.fail(map_[key], "key '" + joinKey(context_, key) + "' has value '" + map_[key].Scalar() +
+                             "', expected an integer");
+  }
+  out = static_cast<int>(v);
+  return *this;
+}
+
+FieldReader& FieldReader::read(const std::string& key, std::string& out) {
+  known_.push_back(key);
+  if (map_[key]) out = doc_.string(map_, key, context_);
+  return *this;
+}
+
+FieldReader& FieldReader::read(const std::string& key, Eigen::Vector3d& out) {
+  known_.push_back(key);
+  if (!map_[key]) return *this;
+  const std::vector<double> v = doc_.numbers(map_, key, 3, context_);
+  out = Eigen::Vector3d(v[0], v[1], v[2]);
+  return *this;
+}
+
+void FieldReader::finish() const { doc_.requireKeys(map_, known_, context_); }
+
 }  // namespace tgnav::harness

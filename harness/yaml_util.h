@@ -2,6 +2,7 @@
 // Strict YAML access for configs: every error names file:line, the dotted key and the value.
 #include <yaml-cpp/yaml.h>
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -37,5 +38,30 @@ class YamlDoc {
 };
 
 std::string joinKey(const std::string& context, const std::string& key);
+
+// Reads the optional fields of one mapping into a config struct, then rejects any key that no
+// field claimed:   FieldReader(doc, node, "position").read("pos_p_xy", c.pos_p_xy).finish();
+class FieldReader {
+ public:
+  FieldReader(const YamlDoc& doc, YAML::Node map, std::string context);
+  FieldReader& read(const std::string& key, double& out);
+  FieldReader& read(const std::string& key, int& out);
+  FieldReader& read(const std::string& key, std::string& out);
+  FieldReader& read(const std::string& key, Eigen::Vector3d& out);
+  // A nested mapping, when present (the callback reads it with its own FieldReader).
+  template <typename Fn>
+  FieldReader& section(const std::string& key, Fn&& read_section) {
+    known_.push_back(key);
+    if (map_[key]) read_section(FieldReader(doc_, map_[key], joinKey(context_, key)));
+    return *this;
+  }
+  void finish() const;
+
+ private:
+  const YamlDoc& doc_;
+  YAML::Node map_;
+  std::string context_;
+  std::vector<std::string> known_;
+};
 
 }  // namespace tgnav::harness

@@ -1,0 +1,51 @@
+#pragma once
+// The whole PX4-like cascade for one vehicle. The stages run at their own rates: the caller
+// (harness FlightLoop) decides when each update is due, so this class holds no clock.
+#include <Eigen/Core>
+
+#include "control/allocator.h"
+#include "control/attitude_control.h"
+#include "control/position_control.h"
+#include "control/rate_control.h"
+
+namespace tgnav::control {
+
+struct CascadeConfig {
+  PositionControlConfig position;
+  AttitudeControlConfig attitude;
+  RateControlConfig rate;
+  double position_rate_hz = 100.0;
+  double attitude_rate_hz = 250.0;
+  double rate_rate_hz = 500.0;
+
+  void validate() const;
+};
+
+class Cascade {
+ public:
+  Cascade(const CascadeConfig& config, const VehicleParams& vehicle);
+
+  // Position/velocity stage: trajectory setpoint -> attitude and thrust setpoint.
+  void updatePosition(const VehicleState& state, const TrajectorySetpoint& setpoint, double dt_s);
+  // Attitude stage: attitude setpoint -> body-rate setpoint.
+  void updateAttitude(const Eigen::Quaterniond& q_WB);
+  // Rate stage and allocation: body-rate setpoint -> rotor thrusts in newtons.
+  Eigen::VectorXd updateRate(const Eigen::Vector3d& w_B, double dt_s);
+  void reset();
+
+  const AttitudeSetpoint& attitudeSetpoint() const { return attitude_sp_; }
+  const Eigen::Vector3d& rateSetpoint() const { return rate_sp_; }
+  const ControlAllocator& allocator() const { return allocator_; }
+  const PositionControl& positionControl() const { return position_; }
+
+ private:
+  PositionControl position_;
+  AttitudeControl attitude_;
+  RateControl rate_;
+  ControlAllocator allocator_;
+  double hover_thrust_;
+  AttitudeSetpoint attitude_sp_;
+  Eigen::Vector3d rate_sp_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace tgnav::control

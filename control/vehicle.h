@@ -1,0 +1,30 @@
+#pragma once
+// Physical description of a multirotor, as control allocation and the controller need it.
+#include <Eigen/Core>
+#include <vector>
+
+namespace tgnav::control {
+
+struct Rotor {
+  Eigen::Vector3d p_B = Eigen::Vector3d::Zero();  // thrust point relative to the centre of mass
+  Eigen::Vector3d axis_B = Eigen::Vector3d::UnitZ();  // thrust direction
+  int spin = 1;                    // +1 counter-clockwise seen from above, -1 clockwise
+  double yaw_moment_ratio_m = 0.0; // drag moment / thrust
+  double max_thrust_n = 0.0;
+};
+
+struct VehicleParams {
+  double mass_kg = 0.0;
+  Eigen::Vector3d inertia_diag_kg_m2 = Eigen::Vector3d::Zero();
+  std::vector<Rotor> rotors;
+  double motor_time_constant_s = 0.0;
+  double gravity_m_s2 = 9.81;
+
+  // Throws std::invalid_argument naming the field and value.
+  void validate() const;
+  double totalMaxThrustN() const;
+  // Normalised collective thrust that balances gravity when level.
+  double hoverThrust() const;
+};
+
+}  // namespace tgnav::control

@@ -1,0 +1,153 @@
+#include "harness/flight_loop.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "harness/errors.h"
+
+namespace tgnav::harness {
+
+void FlightConfig::validate() const {
+  auto positive = [](double v, const char* name) {
+    if (!(v > 0.0)) throw std::invalid_argument(std::string(name) + " = " + std::to_string(v) + ": must be > 0");
+  };
+  positive(takeoff_speed_m_s, "takeoff_speed_m_s");
+  if (!(settle_s >= 0.0)) throw std::invalid_argument("settle_s: must be >= 0");
+  if (!(hold_s >= 0.0)) throw std::invalid_argument("hold_s: must be >= 0");
+  positive(max_start_offset_m, "max_start_offset_m");
+  positive(diverged_tilt_rad, "diverged_tilt_rad");
+  positive(diverged_speed_m_s, "diverged_speed_m_s");
+}
+
+namespace {
+int stepsPer(double physics_hz, double loop_hz, const char* name) {
+  const double ratio = physics_hz / loop_hz;
+  const int n = static_cast<int>(std::lround(ratio));
+  if (n < 1 || std::abs(ratio - n) > 1e-6) {
+    throw InputError(std::string(name) + " = " + std::to_string(loop_hz) +
+                     " Hz does not divide the physics rate of " + std::to_string(physics_hz) + " Hz");
+  }
+  return n;
+}
+}  // namespace
+
+FlightLoop::FlightLoop(mjModel* m, mjData* d, const VehicleIds& ids, const control::CascadeConfig& config)
+    : m_(m), d_(d), ids_(ids), vehicle_(vehicleParamsFromModel(m, ids)), cascade_(config, vehicle_) {
+  const double physics_hz = 1.0 / m->opt.timestep;
+  per_rate_ = stepsPer(physics_hz, config.rate_rate_hz, "rates_hz.rate");
+  per_attitude_ = stepsPer(physics_hz, config.attitude_rate_hz, "rates_hz.attitude");
+  per_position_ = stepsPer(physics_hz, config.position_rate_hz, "rates_hz.position");
+}
+
+void FlightLoop::setDivergenceLimits(double tilt_rad, double speed_m_s) {
+  max_tilt_rad_ = tilt_rad;
+  max_speed_m_s_ = speed_m_s;
+}
+
+bool FlightLoop::checkDiverged() {
+  const control::VehicleState s = state();
+  if (!s.p_WB.allFinite() || !s.v_WB.allFinite() || !s.w_B.allFinite() || !s.q_WB.coeffs().allFinite()) {
+    divergence_ = "non-finite state";
+  } else if (std::acos(std::clamp((s.q_WB * Eigen::Vector3d::UnitZ()).z(), -1.0, 1.0)) > max_tilt_rad_) {
+    divergence_ = "tilt beyond " + std::to_string(max_tilt_rad_ * 180.0 / M_PI) + " deg";
+  } else if (s.v_WB.norm() > max_speed_m_s_) {
+    divergence_ = "speed " + std::to_string(s.v_WB.norm()) + " m/s beyond " + std::to_string(max_speed_m_s_);
+  }
+  return !divergence_.empty();
+}
+
+bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) {
+  if (!divergence_.empty()) return false;
+  const double dt = m_->opt.timestep;
+  const control::VehicleState s = state();
+  if (steps_ % per_position_ == 0) cascade_.updatePosition(s, setpoint, per_position_ * dt);
+  if (steps_ % per_attitude_ == 0) cascade_.updateAttitude(s.q_WB);
+  if (steps_ % per_rate_ == 0) {
+    const Eigen::VectorXd thrust_n = cascade_.updateRate(s.w_B, per_rate_ * dt);
+    if (!thrust_n.allFinite()) {
+      divergence_ = "non-finite motor command";
+      return false;
+    }
+    for (int i = 0; i < 4; ++i) d_->ctrl[ids_.motors[i]] = thrust_n[i];
+  }
+  mj_step(m_, d_);
+  ++steps_;
+  return !checkDiverged();
+}
+
+FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory,
+                           const FlightConfig& config) {
+  config.validate();
+  loop.setDivergenceLimits(config.diverged_tilt_rad, config.diverged_speed_m_s);
+  FlightResult result;
+  const control::TrajectorySetpoint first = trajectory.sample(trajectory.startTime());
+  const control::VehicleState start = loop.state();
+  const double climb_m = first.p_WB.z() - start.p_WB.z();
+  const double climb_s = std::abs(climb_m) / config.takeoff_speed_m_s;
+  const double t0 = loop.time();
+  result.trajectory_start_s = t0 + climb_s + config.settle_s;
+  const double t_end = result.trajectory_start_s + (trajectory.endTime() - trajectory.startTime()) + config.hold_s;
+
+  while (loop.time() < t_end - 1e-9) {
+    const double t = loop.time();
+    control::TrajectorySetpoint sp;
+    bool on_trajectory = false;
+    if (t < t0 + climb_s) {
+      // Vertical ramp above the start towards the first setpoint's height.
+      const double s = (t - t0) / climb_s;
+      sp.p_WB = Eigen::Vector3d(first.p_WB.x(), first.p_WB.y(), start.p_WB.z() + s * climb_m);
+      sp.v_WB = Eigen::Vector3d(0.0, 0.0, std::copysign(config.takeoff_speed_m_s, climb_m));
+      sp.yaw_rad = first.yaw_rad;
+    } else if (t < result.trajectory_start_s) {
+      sp = first;
+      sp.v_WB.setZero();
+      sp.a_WB.setZero();
+      sp.yaw_rate_rad_s = 0.0;
+    } else {
+      const double tt = trajectory.startTime() + (t - result.trajectory_start_s);
+      sp = trajectory.sample(tt);
+      on_trajectory = tt <= trajectory.endTime();
+    }
+    const bool log_now = loop.positionUpdateDue();
+    if (log_now) result.log.push_back(FlightSample{t, on_trajectory, sp, loop.state()});
+    if (!loop.step(sp)) {
+      result.status = FlightStatus::kDiverged;
+      result.reason = loop.divergence();
+      break;
+    }
+  }
+  return result;
+}
+
+TrackingSummary summarizeTracking(const FlightResult& result) {
+  TrackingSummary s;
+  double sum_sq = 0.0;
+  double yaw_sq = 0.0;
+  double first_t = 0.0;
+  double last_t = 0.0;
+  for (const FlightSample& f : result.log) {
+    if (!f.on_trajectory) continue;
+    const double e = (f.state.p_WB - f.setpoint.p_WB).norm();
+    const Eigen::Vector3d nose = f.state.q_WB * Eigen::Vector3d::UnitX();
+    const double yaw_err = std::remainder(std::atan2(nose.y(), nose.x()) - f.setpoint.yaw_rad, 2.0 * M_PI);
+    if (s.samples == 0) first_t = f.t_s;
+    last_t = f.t_s;
+    sum_sq += e * e;
+    yaw_sq += yaw_err * yaw_err;
+    s.position_max_m = std::max(s.position_max_m, e);
+    ++s.samples;
+  }
+  if (s.samples > 0) {
+    s.position_rmse_m = std::sqrt(sum_sq / s.samples);
+    s.yaw_rmse_rad = std::sqrt(yaw_sq / s.samples);
+    s.duration_s = last_t - first_t;
+  }
+  if (!result.log.empty()) {
+    const FlightSample& last = result.log.back();
+    s.final_error_m = (last.state.p_WB - last.setpoint.p_WB).norm();
+  }
+  return s;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,94 @@
+#pragma once
+// Closed loop of MuJoCo and the PX4-like cascade: physics every step, rate control and
+// allocation at rate_rate_hz, attitude at attitude_rate_hz, position at position_rate_hz.
+// State comes from ground truth (the paper flew its vehicle on motion capture).
+#include <mujoco/mujoco.h>
+
+#include <string>
+#include <vector>
+
+#include "control/cascade.h"
+#include "control/trajectory.h"
+#include "harness/mujoco_sim.h"
+
+namespace tgnav::harness {
+
+struct FlightConfig {
+  double takeoff_speed_m_s = 1.0;  // climb from the ground to the first setpoint (MPC_TKO_SPEED)
+  double settle_s = 1.0;           // hover at the first setpoint before the trajectory starts
+  double hold_s = 2.0;             // keep holding the last setpoint after the trajectory ends
+  double max_start_offset_m = 0.5; // first setpoint vs. start pose, horizontally
+  double diverged_tilt_rad = M_PI / 2;  // beyond these the flight stops as diverged
+  double diverged_speed_m_s = 20.0;
+
+  void validate() const;
+};
+
+class FlightLoop {
+ public:
+  // InputError when the loop rates do not divide the physics rate.
+  FlightLoop(mjModel* m, mjData* d, const VehicleIds& ids, const control::CascadeConfig& config);
+
+  // One physics step with the controller stages that are due. Returns false when the flight
+  // diverged or a command was not finite; motor commands then stay unchanged and divergence()
+  // says why. Nothing non-finite ever reaches MuJoCo.
+  bool step(const control::TrajectorySetpoint& setpoint);
+  control::VehicleState state() const { return vehicleState(d_, ids_); }
+  double time() const { return d_->time; }
+  bool positionUpdateDue() const { return steps_ % per_position_ == 0; }
+  const std::string& divergence() const { return divergence_; }
+  const control::VehicleParams& vehicle() const { return vehicle_; }
+  const control::Cascade& cascade() const { return cascade_; }
+  // Thresholds of the divergence check.
+  void setDivergenceLimits(double tilt_rad, double speed_m_s);
+
+ private:
+  bool checkDiverged();
+
+  mjModel* m_;
+  mjData* d_;
+  VehicleIds ids_;
+  control::VehicleParams vehicle_;
+  control::Cascade cascade_;
+  int per_rate_ = 1;
+  int per_attitude_ = 2;
+  int per_position_ = 5;
+  long steps_ = 0;
+  double max_tilt_rad_ = M_PI / 2;
+  double max_speed_m_s_ = 20.0;
+  std::string divergence_;
+};
+
+enum class FlightStatus { kCompleted, kDiverged };
+
+struct FlightSample {
+  double t_s = 0.0;
+  bool on_trajectory = false;  // false during take-off, settling and the final hold
+  control::TrajectorySetpoint setpoint;
+  control::VehicleState state;
+};
+
+struct FlightResult {
+  FlightStatus status = FlightStatus::kCompleted;
+  std::string reason;          // why it diverged
+  double trajectory_start_s = 0.0;  // sim time at which the trajectory's first setpoint applied
+  std::vector<FlightSample> log;    // at the position-loop rate
+};
+
+// Takes off from the vehicle's current (landed) pose to the trajectory's first setpoint,
+// settles, flies the trajectory and holds its end.
+FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory,
+                           const FlightConfig& config);
+
+struct TrackingSummary {
+  double duration_s = 0.0;
+  double position_rmse_m = 0.0;
+  double position_max_m = 0.0;
+  double yaw_rmse_rad = 0.0;
+  double final_error_m = 0.0;  // at the end of the hold
+  int samples = 0;
+};
+// Errors over the samples on the trajectory.
+TrackingSummary summarizeTracking(const FlightResult& result);
+
+}  // namespace tgnav::harness
