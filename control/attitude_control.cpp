@@ -1,3 +1,4 @@
+#include "control/check.h"
 #include "control/attitude_control.h"
 
 #include <algorithm>
@@ -8,9 +9,6 @@
 namespace tgnav::control {
 
 namespace {
-void require(bool ok, const std::string& field, double value, const std::string& rule) {
-  if (!ok) throw std::invalid_argument(field + " = " + std::to_string(value) + ": " + rule);
-}
 Eigen::Quaterniond canonical(const Eigen::Quaterniond& q) {
   return q.w() < 0.0 ? Eigen::Quaterniond(-q.w(), -q.x(), -q.y(), -q.z()) : q;
 }

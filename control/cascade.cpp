@@ -1,5 +1,7 @@
 #include "control/cascade.h"
 
+#include "control/check.h"
+
 #include <stdexcept>
 #include <string>
 
@@ -9,15 +11,11 @@ void CascadeConfig::validate() const {
   position.validate();
   attitude.validate();
   rate.validate();
-  auto positive = [](double v, const char* name) {
-    if (!(v > 0.0)) throw std::invalid_argument(std::string(name) + " = " + std::to_string(v) + ": must be > 0");
-  };
-  positive(position_rate_hz, "position_rate_hz");
-  positive(attitude_rate_hz, "attitude_rate_hz");
-  positive(rate_rate_hz, "rate_rate_hz");
-  if (position_rate_hz > attitude_rate_hz || attitude_rate_hz > rate_rate_hz) {
-    throw std::invalid_argument("rates: position_rate_hz <= attitude_rate_hz <= rate_rate_hz required");
-  }
+  require(position_rate_hz > 0.0 && position_rate_hz <= attitude_rate_hz, "rates_hz.position",
+          position_rate_hz, "must be > 0 and <= rates_hz.attitude");
+  require(attitude_rate_hz <= rate_rate_hz, "rates_hz.attitude", attitude_rate_hz,
+          "must be <= rates_hz.rate");
+  require(rate_rate_hz > 0.0, "rates_hz.rate", rate_rate_hz, "must be > 0");
 }
 
 Cascade::Cascade(const CascadeConfig& config, const VehicleParams& vehicle)

@@ -1,3 +1,4 @@
+#include "control/check.h"
 #include "control/position_control.h"
 
 #include <algorithm>
@@ -6,12 +7,6 @@
 #include <string>
 
 namespace tgnav::control {
-
-namespace {
-void require(bool ok, const std::string& field, double value, const std::string& rule) {
-  if (!ok) throw std::invalid_argument(field + " = " + std::to_string(value) + ": " + rule);
-}
-}  // namespace
 
 void PositionControlConfig::validate() const {
   require(pos_p_xy > 0.0, "pos_p_xy", pos_p_xy, "must be > 0");

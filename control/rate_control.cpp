@@ -1,5 +1,7 @@
 #include "control/rate_control.h"
 
+#include "control/check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -11,10 +13,8 @@ void RateControlConfig::validate() const {
   const char* names[] = {"roll", "pitch", "yaw"};
   for (int a = 0; a < 3; ++a) {
     auto check = [&](double v, const char* what) {
-      if (!(v >= 0.0) || !std::isfinite(v)) {
-        throw std::invalid_argument(std::string(what) + "." + names[a] + " = " + std::to_string(v) +
-                                    ": must be finite and >= 0");
-      }
+      require(v >= 0.0 && std::isfinite(v), std::string("rate.") + what + "." + names[a], v,
+              "must be finite and >= 0");
     };
     check(p[a], "p");
     check(i[a], "i");
@@ -22,9 +22,7 @@ void RateControlConfig::validate() const {
     check(ff[a], "ff");
     check(integrator_limit[a], "integrator_limit");
   }
-  if (!(dterm_cutoff_hz > 0.0)) {
-    throw std::invalid_argument("dterm_cutoff_hz = " + std::to_string(dterm_cutoff_hz) + ": must be > 0");
-  }
+  require(dterm_cutoff_hz > 0.0, "rate.dterm_cutoff_hz", dterm_cutoff_hz, "must be > 0");
 }
 
 RateControl::RateControl(const RateControlConfig& config) : config_(config) { config_.validate(); }

@@ -1,5 +1,7 @@
 #include "control/vehicle.h"
 
+#include "control/check.h"
+
 #include <stdexcept>
 #include <string>
 
@@ -7,22 +9,20 @@ namespace tgnav::control {
 
 void VehicleParams::validate() const {
   auto fail = [](const std::string& what) { throw std::invalid_argument(what); };
-  if (!(mass_kg > 0.0)) fail("mass_kg = " + std::to_string(mass_kg) + ": must be > 0");
+  require(mass_kg > 0.0, "mass_kg", mass_kg, "must be > 0");
   if (!(inertia_diag_kg_m2.array() > 0.0).all()) fail("inertia_diag_kg_m2: must be > 0 on every axis");
   if (rotors.size() < 4) fail("rotors: " + std::to_string(rotors.size()) + " rotors, need >= 4");
   for (std::size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];
     const std::string name = "rotors[" + std::to_string(i) + "].";
-    if (!(r.max_thrust_n > 0.0)) fail(name + "max_thrust_n = " + std::to_string(r.max_thrust_n) + ": must be > 0");
-    if (r.spin != 1 && r.spin != -1) fail(name + "spin = " + std::to_string(r.spin) + ": must be +1 or -1");
+    require(r.max_thrust_n > 0.0, name + "max_thrust_n", r.max_thrust_n, "must be > 0");
+    require(r.spin == 1 || r.spin == -1, name + "spin", r.spin, "must be +1 or -1");
     if (!(r.yaw_moment_ratio_m >= 0.0)) fail(name + "yaw_moment_ratio_m: must be >= 0");
     if (std::abs(r.axis_B.norm() - 1.0) > 1e-6) fail(name + "axis_B: must be a unit vector");
   }
   if (!(motor_time_constant_s >= 0.0)) fail("motor_time_constant_s: must be >= 0");
   if (!(gravity_m_s2 > 0.0)) fail("gravity_m_s2: must be > 0");
-  if (hoverThrust() >= 0.9) {
-    fail("hover thrust " + std::to_string(hoverThrust()) + " of maximum: vehicle too heavy to fly");
-  }
+  require(hoverThrust() < 0.9, "hover thrust (of maximum)", hoverThrust(), "vehicle too heavy to fly");
 }
 
 double VehicleParams::totalMaxThrustN() const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 #include "harness/errors.h"
@@ -25,8 +26,10 @@ int stepsPer(double physics_hz, double loop_hz, const char* name) {
   const double ratio = physics_hz / loop_hz;
   const int n = static_cast<int>(std::lround(ratio));
   if (n < 1 || std::abs(ratio - n) > 1e-6) {
-    throw InputError(std::string(name) + " = " + std::to_string(loop_hz) +
-                     " Hz does not divide the physics rate of " + std::to_string(physics_hz) + " Hz");
+    std::ostringstream msg;
+    msg << "controller " << name << " = " << loop_hz << " Hz does not divide the physics rate of "
+        << physics_hz << " Hz";
+    throw InputError(msg.str());
   }
   return n;
 }
@@ -84,7 +87,8 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
   const control::TrajectorySetpoint first = trajectory.sample(trajectory.startTime());
   const control::VehicleState start = loop.state();
   const double climb_m = first.p_WB.z() - start.p_WB.z();
-  const double climb_s = std::abs(climb_m) / config.takeoff_speed_m_s;
+  // Smoothstep climb (zero speed at both ends) whose peak speed is takeoff_speed_m_s.
+  const double climb_s = 1.5 * std::abs(climb_m) / config.takeoff_speed_m_s;
   const double t0 = loop.time();
   result.trajectory_start_s = t0 + climb_s + config.settle_s;
   const double t_end = result.trajectory_start_s + (trajectory.endTime() - trajectory.startTime()) + config.hold_s;
@@ -94,10 +98,10 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
     control::TrajectorySetpoint sp;
     bool on_trajectory = false;
     if (t < t0 + climb_s) {
-      // Vertical ramp above the start towards the first setpoint's height.
       const double s = (t - t0) / climb_s;
-      sp.p_WB = Eigen::Vector3d(first.p_WB.x(), first.p_WB.y(), start.p_WB.z() + s * climb_m);
-      sp.v_WB = Eigen::Vector3d(0.0, 0.0, std::copysign(config.takeoff_speed_m_s, climb_m));
+      sp.p_WB = Eigen::Vector3d(first.p_WB.x(), first.p_WB.y(), start.p_WB.z() + climb_m * s * s * (3 - 2 * s));
+      sp.v_WB = Eigen::Vector3d(0.0, 0.0, climb_m * 6 * s * (1 - s) / climb_s);
+      sp.a_WB = Eigen::Vector3d(0.0, 0.0, climb_m * (6 - 12 * s) / (climb_s * climb_s));
       sp.yaw_rad = first.yaw_rad;
     } else if (t < result.trajectory_start_s) {
       sp = first;

@@ -14,7 +14,7 @@
 namespace tgnav::harness {
 
 struct FlightConfig {
-  double takeoff_speed_m_s = 1.0;  // climb from the ground to the first setpoint (MPC_TKO_SPEED)
+  double takeoff_speed_m_s = 1.0;  // peak climb speed from the ground to the first setpoint
   double settle_s = 1.0;           // hover at the first setpoint before the trajectory starts
   double hold_s = 2.0;             // keep holding the last setpoint after the trajectory ends
   double max_start_offset_m = 0.5; // first setpoint vs. start pose, horizontally

@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
     return "tgnav: error: " + std::string(e.what()) + " (see --help)\n";
   });
   tgnav::cli::addRenderCommand(app);
+  tgnav::cli::addFlyCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -12,7 +12,8 @@ std::string toTum(const std::vector<StampedPose>& poses) {
   out << std::fixed;
   out << "# timestamp tx ty tz qx qy qz qw\n";
   for (const StampedPose& p : poses) {
-    const Eigen::Quaterniond q(p.X_WC.linear());
+    Eigen::Quaterniond q(p.X_WC.linear());
+    if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // one sign per rotation: w >= 0
     const Eigen::Vector3d& t = p.X_WC.translation();
     out << p.t_s << ' ' << t.x() << ' ' << t.y() << ' ' << t.z() << ' ' << q.x() << ' ' << q.y() << ' '
         << q.z() << ' ' << q.w() << '\n';

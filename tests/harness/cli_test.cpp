@@ -5,6 +5,8 @@
 
 #include <array>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
 #include "test_util.h"
@@ -99,6 +101,59 @@ TEST(CliRender, MissingEglSaysWhatToInstall) {
   EXPECT_EQ(lines(run.output), 1) << run.output;
   EXPECT_NE(run.output.find("install libegl1 libegl-mesa0 libgl1-mesa-dri"), std::string::npos)
       << run.output;
+}
+
+std::string pillarCsv() {
+  return (test::sourceDir() / "configs/trajectories/smoke_around_pillar.csv").string();
+}
+
+TEST(CliFly, FliesAroundThePillarAndWritesResults) {
+  const auto out = test::tempDir() / "out";
+  const CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + pillarCsv() + " --out " + out.string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("tgnav fly: completed"), std::string::npos) << run.output;
+  for (const char* f : {"gt.tum", "flight.csv", "tracking.json"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / f)) << f;
+  }
+  std::ifstream json(out / "tracking.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"status\": \"completed\""), std::string::npos) << text;
+  // 100 Hz ground truth over take-off, settling, 14.76 s of trajectory and the 2 s hold.
+  std::ifstream tum(out / "gt.tum");
+  int rows = 0;
+  for (std::string line; std::getline(tum, line);) rows += (!line.empty() && line[0] != '#');
+  EXPECT_GT(rows, 1700);
+}
+
+TEST(CliFly, BadTrajectoryIsOneLineExit2AndWritesNothing) {
+  const auto dir = test::tempDir();
+  const auto csv = test::writeFile(dir / "bad.csv", "t,x,y,z,yaw\n0,-3,0,1,0\n2,-2,0,1,0\n1,-1,0,1,0\n");
+  const CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + csv.string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(csv.string() + ":4: column 't' has value '1'"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "o"));
+}
+
+TEST(CliFly, TrajectoryOutsideTheSceneIsRejected) {
+  const auto dir = test::tempDir();
+  const auto far = test::writeFile(dir / "far.csv", "t,x,y,z,yaw\n0,2,2,1,0\n");
+  CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + far.string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("from the scene's start"), std::string::npos) << run.output;
+  const auto out_of_bounds = test::writeFile(dir / "oob.csv", "t,x,y,z,yaw\n0,-3,0,1,0\n5,-3,0,7,0\n");
+  run = tgnav("fly --scene " + smoke() + " --trajectory " + out_of_bounds.string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("outside the scene bounds"), std::string::npos) << run.output;
+}
+
+TEST(CliFly, ControllerConfigErrorsNameTheKey) {
+  const auto dir = test::tempDir();
+  const auto yaml = test::writeFile(dir / "c.yaml", "rates_hz:\n  position: 300\n");
+  const CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + pillarCsv() + " --controller " +
+                              yaml.string() + " --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find(yaml.string() + ": rates_hz.position = 300"), std::string::npos) << run.output;
 }
 
 TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
