@@ -1,5 +1,7 @@
 #include "harness/scene_config.h"
 
+#include <cmath>
+
 #include "harness/errors.h"
 #include "harness/yaml_util.h"
 
@@ -18,7 +20,7 @@ planner::Pose4 readPose(const YamlDoc& doc, const std::string& key) {
 SceneConfig loadSceneConfig(const std::filesystem::path& yaml) {
   const YamlDoc doc = YamlDoc::load(yaml);
   const YAML::Node& root = doc.root();
-  doc.requireKeys(root, {"mjcf", "flight_height_m", "start", "goal", "bounds"}, "");
+  doc.requireKeys(root, {"mjcf", "flight_height_m", "start", "goal", "bounds", "survey"}, "");
   SceneConfig scene;
   scene.source = yaml;
   const std::string mjcf = doc.string(root, "mjcf", "");
@@ -50,6 +52,30 @@ SceneConfig loadSceneConfig(const std::filesystem::path& yaml) {
     doc.fail(root["flight_height_m"], "key 'flight_height_m' = " +
                                           std::to_string(scene.flight_height_m) +
                                           " lies outside the bounds' z range");
+  }
+  const YAML::Node survey = doc.child(root, "survey", "");
+  doc.requireKeys(survey, {"spacing_m", "heights_m", "yaw_count", "clearance_m"}, "survey");
+  SurveyPlan& plan = scene.survey;
+  plan.spacing_m = doc.number(survey, "spacing_m", "survey");
+  plan.clearance_m = doc.number(survey, "clearance_m", "survey");
+  const double yaws = doc.number(survey, "yaw_count", "survey");
+  const YAML::Node heights = doc.child(survey, "heights_m", "survey");
+  if (!heights.IsSequence() || heights.size() == 0) {
+    doc.fail(heights, "key 'survey.heights_m' must be a non-empty list of heights in metres");
+  }
+  plan.heights_m = doc.numbers(survey, "heights_m", heights.size(), "survey");
+  if (!(plan.spacing_m >= 0.1)) doc.fail(survey["spacing_m"], "key 'survey.spacing_m' must be >= 0.1 m");
+  if (!(plan.clearance_m >= 0.0)) doc.fail(survey["clearance_m"], "key 'survey.clearance_m' must be >= 0");
+  if (yaws != std::floor(yaws) || yaws < 1 || yaws > 64) {
+    doc.fail(survey["yaw_count"], "key 'survey.yaw_count' has value '" + survey["yaw_count"].Scalar() +
+                                      "', expected an integer in [1, 64]");
+  }
+  plan.yaw_count = static_cast<int>(yaws);
+  for (std::size_t i = 0; i < plan.heights_m.size(); ++i) {
+    if (plan.heights_m[i] <= scene.bounds_min_m.z() || plan.heights_m[i] >= scene.bounds_max_m.z()) {
+      doc.fail(heights[i], "key 'survey.heights_m' has value '" + heights[i].Scalar() +
+                               "' outside the bounds' z range");
+    }
   }
   return scene;
 }

@@ -83,7 +83,8 @@ class SceneErrors : public ::testing::Test {
   }
   const std::string valid_ =
       "mjcf: world.xml\nflight_height_m: 1.0\nstart: [0, 0, 1, 0]\ngoal: [1, 1, 1, 0]\n"
-      "bounds: {min: [-1, -1, 0], max: [2, 2, 3]}\n";
+      "bounds: {min: [-1, -1, 0], max: [2, 2, 3]}\n"
+      "survey: {spacing_m: 1.0, heights_m: [0.8, 1.2], yaw_count: 8, clearance_m: 0.4}\n";
 };
 
 TEST_F(SceneErrors, ValidSceneHasNoError) { EXPECT_EQ(load(valid_), ""); }
@@ -117,6 +118,18 @@ TEST_F(SceneErrors, NestedUnknownKeyHasDottedName) {
   std::string text = valid_;
   text.replace(text.find("max: [2, 2, 3]"), 14, "max: [2, 2, 3], mid: [0, 0, 0]");
   EXPECT_NE(load(text).find("unknown key 'bounds.mid'"), std::string::npos);
+}
+
+TEST_F(SceneErrors, SurveyHeightOutsideBoundsIsRejected) {
+  std::string text = valid_;
+  text.replace(text.find("heights_m: [0.8, 1.2]"), 21, "heights_m: [0.8, 3.5]");
+  EXPECT_NE(load(text).find("'survey.heights_m' has value '3.5'"), std::string::npos) << load(text);
+}
+
+TEST_F(SceneErrors, SurveyYawCountMustBeAnInteger) {
+  std::string text = valid_;
+  text.replace(text.find("yaw_count: 8"), 12, "yaw_count: 2.5");
+  EXPECT_NE(load(text).find("'survey.yaw_count' has value '2.5'"), std::string::npos) << load(text);
 }
 
 TEST(SceneFile, UnknownExtensionIsRejected) {
