@@ -52,6 +52,7 @@ int main(int argc, char** argv) {
   });
   tgnav::cli::addRenderCommand(app);
   tgnav::cli::addFlyCommand(app);
+  tgnav::cli::addMapCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

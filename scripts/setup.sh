@@ -9,7 +9,7 @@ packages=(
   g++ cmake make pkg-config
   libmujoco-dev libqhull-dev          # MuJoCo 2.2 (its CMake target names qhull's include dir)
   libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri   # headless EGL, llvmpipe software GL
-  libeigen3-dev libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
+  libeigen3-dev libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev liboctomap-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

@@ -1,0 +1,82 @@
+#pragma once
+// Occlusion-aware feature map (paper Sec. IV): a volumetric occupancy map (OctoMap) with the
+// SLAM landmarks embedded in its surface voxels, so that the planner can ask which landmarks a
+// camera at a given pose would see, occlusion included.
+#include <octomap/OcTree.h>
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+namespace tgnav::planner {
+
+struct Landmark {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();        // mean of its observations
+  int observations = 1;
+  Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero(); // camera position that first saw it
+  std::array<std::uint8_t, 32> descriptor{};            // ORB, from the reference observation
+};
+
+// Sensing model of the query (V(p) uses range and vertical FoV; yaw filters by horizontal FoV).
+struct VisibilityConfig {
+  double hfov_rad = 1.3125;  // 75.2 deg: fovy 60 deg at 4:3
+  double vfov_rad = 1.0472;  // 60 deg
+  double min_range_m = 0.3;
+  double max_range_m = 6.0;
+
+  void validate() const;
+};
+
+class FeatureMap {
+ public:
+  explicit FeatureMap(double resolution_m);
+
+  octomap::OcTree& occupancy() { return *tree_; }
+  const octomap::OcTree& occupancy() const { return *tree_; }
+  double resolution() const { return tree_->getResolution(); }
+  // Occupied per the map (unknown counts as not occupied).
+  bool isOccupied(const Eigen::Vector3d& p_W) const;
+  // Known (observed) at all.
+  bool isKnown(const Eigen::Vector3d& p_W) const;
+
+  // Adds landmarks; call embedLandmarks() once all are in.
+  void setLandmarks(std::vector<Landmark> landmarks);
+  const std::vector<Landmark>& landmarks() const { return landmarks_; }
+
+  // Embeds every landmark in the surface voxel its reference keyframe sees it on: the first
+  // occupied voxel on the ray from the keyframe towards the landmark, if that voxel lies
+  // within `max_shift_m` of it. Landmarks without such a voxel (seen through free space, or
+  // occluded from their own keyframe) are dropped. Returns how many were dropped.
+  int embedLandmarks(double max_shift_m);
+  // Voxel centre each landmark is embedded in (after embedLandmarks()).
+  Eigen::Vector3d landmarkVoxel(int id) const;
+
+  // V(p): ids of the landmarks within range and the vertical FoV of a camera at p (any yaw)
+  // whose surface voxel is the first occupied voxel on the line of sight. Sorted ascending.
+  std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
+  // The subset of `candidates` inside the horizontal FoV of a camera at p with yaw `yaw_rad`.
+  std::vector<int> inHorizontalFov(const Eigen::Vector3d& p_W, double yaw_rad,
+                                   const std::vector<int>& candidates,
+                                   const VisibilityConfig& config) const;
+
+  // map.bt (OctoMap binary) and landmarks.csv in `dir`; load() throws std::runtime_error naming
+  // the file on malformed input.
+  void save(const std::filesystem::path& dir) const;
+  static FeatureMap load(const std::filesystem::path& dir);
+
+ private:
+  std::unique_ptr<octomap::OcTree> tree_;
+  std::vector<Landmark> landmarks_;
+  std::vector<octomap::OcTreeKey> landmark_key_;
+  // Embedded landmarks grouped by voxel: one ray per voxel answers for all of them.
+  std::unordered_map<octomap::OcTreeKey, std::vector<int>, octomap::OcTreeKey::KeyHash> by_voxel_;
+};
+
+// Number of differing bits between two ORB descriptors.
+int hammingDistance(const std::array<std::uint8_t, 32>& a, const std::array<std::uint8_t, 32>& b);
+
+}  // namespace tgnav::planner

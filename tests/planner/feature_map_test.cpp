@@ -1,0 +1,118 @@
+// Visibility in the occlusion-aware feature map, on a hand-built map: a wall hides what is
+// behind it, the vertical and horizontal FoV and the range limit what a camera can see.
+#include "planner/feature_map.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace tgnav::planner {
+namespace {
+
+constexpr double kRes = 0.1;
+
+// Marks the axis-aligned box [lo, hi] occupied and the rest of [-5, 5]^2 x [0, 3] free.
+void fillBox(octomap::OcTree& tree, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  for (double x = -5 + kRes / 2; x < 5; x += kRes) {
+    for (double y = -5 + kRes / 2; y < 5; y += kRes) {
+      for (double z = kRes / 2; z < 3; z += kRes) {
+        const bool inside = x > lo.x() && x < hi.x() && y > lo.y() && y < hi.y() && z > lo.z() && z < hi.z();
+        tree.updateNode(octomap::point3d(x, y, z), inside);
+      }
+    }
+  }
+}
+
+Landmark at(double x, double y, double z, const Eigen::Vector3d& seen_from) {
+  Landmark lm;
+  lm.p_W = Eigen::Vector3d(x, y, z);
+  lm.ref_kf_p_W = seen_from;
+  return lm;
+}
+
+class FeatureMapTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // A wall in the plane x = 0 (0.2 m thick, y in [-2, 2], z in [0, 2.5]).
+    fillBox(map_.occupancy(), {-0.1, -2.0, 0.0}, {0.1, 2.0, 2.5});
+    const Eigen::Vector3d west(-2, 0, 1), east(2, 0, 1);
+    map_.setLandmarks({
+        at(-0.1, 0.0, 1.0, west),   // 0: west face, centre
+        at(-0.1, 1.0, 1.0, west),   // 1: west face, left
+        at(0.1, 0.0, 1.0, east),    // 2: east face, centre
+        at(0.1, -1.0, 1.0, east),   // 3: east face
+        at(-0.1, 0.0, 2.0, west),   // 4: west face, high up (28 deg above the horizon from west)
+        at(-1.5, 0.0, 1.0, west),   // 5: floating in free space: no surface, dropped
+    });
+    dropped_ = map_.embedLandmarks(0.15);
+  }
+  FeatureMap map_{kRes};
+  int dropped_ = 0;
+};
+
+TEST_F(FeatureMapTest, LandmarksEmbedInTheSurfaceVoxelTheirKeyframeSees) {
+  EXPECT_EQ(dropped_, 1);
+  ASSERT_EQ(map_.landmarks().size(), 5u);
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_TRUE(map_.isOccupied(map_.landmarkVoxel(i)));
+    EXPECT_LT((map_.landmarkVoxel(i) - map_.landmarks()[i].p_W).norm(), kRes);
+  }
+  EXPECT_LT(map_.landmarkVoxel(0).x(), 0.0);  // west face voxel
+  EXPECT_GT(map_.landmarkVoxel(2).x(), 0.0);  // east face voxel
+}
+
+TEST_F(FeatureMapTest, WallHidesTheFarSide) {
+  VisibilityConfig config;
+  EXPECT_EQ(map_.visibleFrom({-2.0, 0.0, 1.0}, config), (std::vector<int>{0, 1, 4}));
+  EXPECT_EQ(map_.visibleFrom({2.0, 0.0, 1.0}, config), (std::vector<int>{2, 3}));
+}
+
+TEST_F(FeatureMapTest, VerticalFovAndRangeLimitVisibility) {
+  VisibilityConfig config;
+  config.vfov_rad = 40 * M_PI / 180;  // landmark 4 is 28 deg up: outside +-20 deg
+  EXPECT_EQ(map_.visibleFrom({-2.0, 0.0, 1.0}, config), (std::vector<int>{0, 1}));
+  config = VisibilityConfig{};
+  config.max_range_m = 1.5;
+  EXPECT_TRUE(map_.visibleFrom({-2.0, 0.0, 1.0}, config).empty());
+}
+
+TEST_F(FeatureMapTest, HorizontalFovSelectsByYaw) {
+  VisibilityConfig config;
+  const Eigen::Vector3d p(-2.0, 0.0, 1.0);
+  const std::vector<int> all = map_.visibleFrom(p, config);
+  EXPECT_EQ(map_.inHorizontalFov(p, 0.0, all, config), (std::vector<int>{0, 1, 4}));
+  EXPECT_TRUE(map_.inHorizontalFov(p, M_PI, all, config).empty());
+  // Looking 40 deg to the left: landmark 1 (bearing 26.6 deg) stays, 0 and 4 (0 deg) are at
+  // the edge of a 75 deg FoV (half 37.6 deg): out.
+  EXPECT_EQ(map_.inHorizontalFov(p, 40 * M_PI / 180, all, config), (std::vector<int>{1}));
+}
+
+TEST_F(FeatureMapTest, SaveLoadRoundTrip) {
+  const auto dir = std::filesystem::temp_directory_path() / "tgnav_feature_map_roundtrip";
+  std::filesystem::create_directories(dir);
+  map_.save(dir);
+  const FeatureMap back = FeatureMap::load(dir);
+  ASSERT_EQ(back.landmarks().size(), map_.landmarks().size());
+  EXPECT_EQ(back.visibleFrom({-2.0, 0.0, 1.0}, VisibilityConfig{}), (std::vector<int>{0, 1, 4}));
+  EXPECT_DOUBLE_EQ(back.resolution(), kRes);
+}
+
+TEST(FeatureMapLoad, MissingFilesAreNamed) {
+  try {
+    FeatureMap::load("/nonexistent/map");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/map/map.bt"), std::string::npos);
+  }
+}
+
+TEST(Hamming, CountsBits) {
+  std::array<std::uint8_t, 32> a{}, b{};
+  b[0] = 0xff;
+  b[31] = 0x01;
+  EXPECT_EQ(hammingDistance(a, b), 9);
+  EXPECT_EQ(hammingDistance(b, b), 0);
+}
+
+}  // namespace
+}  // namespace tgnav::planner
