@@ -1,5 +1,6 @@
 // tgnav map: the mapping run of a scene -> occlusion-aware feature map on disk.
 #include <nlohmann/json.hpp>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -19,6 +20,29 @@ struct MapOptions {
   std::string scene;
   std::string out;
   double resolution_m = 0.1;
+};
+
+// OctoMap's binary writer prints " done." on stderr; keep the program's output to its own lines.
+class QuietStderr {
+ public:
+  QuietStderr() : saved_(dup(STDERR_FILENO)) {
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) {
+      dup2(null, STDERR_FILENO);
+      close(null);
+    }
+  }
+  ~QuietStderr() {
+    if (saved_ >= 0) {
+      dup2(saved_, STDERR_FILENO);
+      close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_;
 };
 
 nlohmann::ordered_json summaryJson(const harness::SceneConfig& scene, const harness::MapBuildConfig& c,
@@ -64,7 +88,10 @@ void runMap(const MapOptions& opt) {
   const std::filesystem::path tmp = out.string() + ".partial";
   std::filesystem::remove_all(tmp);
   harness::makeOutputDir(tmp);
-  map.save(tmp);
+  {
+    const QuietStderr quiet;
+    map.save(tmp);
+  }
   // About 800 pixels across, whatever the scene's size.
   harness::Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / 800.0);
   topdown.drawMap(map, 0.3);

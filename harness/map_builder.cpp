@@ -17,6 +17,9 @@ namespace tgnav::harness {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+// Rotor tips of models/quadrotor.xml: 0.25 m arm + 0.12 m propeller, rounded down: the start
+// and goal must leave at least this much room.
+constexpr double kVehicleRadiusM = 0.3;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // A landmark being accumulated over observations.
@@ -129,6 +132,7 @@ std::vector<planner::Pose4> surveyPoses(const SceneConfig& scene) {
   ModelPtr model = loadModel(scene.mjcf);
   DataPtr data = makeData(model.get());
   mj_forward(model.get(), data.get());
+  checkStartGoalFree(scene, model.get(), data.get(), kVehicleRadiusM);
   const SceneGeometry geometry(model.get(), data.get());
   const SurveyPlan& plan = scene.survey;
   std::vector<planner::Pose4> poses;

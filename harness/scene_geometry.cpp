@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
+
+#include "harness/errors.h"
+#include "harness/scene_config.h"
 
 namespace tgnav::harness {
 
@@ -52,6 +56,20 @@ double SceneGeometry::distanceToSurface(const Eigen::Vector3d& p_W) const {
   double best = std::numeric_limits<double>::infinity();
   for (const Shape& s : shapes_) best = std::min(best, std::abs(shapeDistance(s, p_W)));
   return best;
+}
+
+void checkStartGoalFree(const SceneConfig& scene, const mjModel* m, const mjData* d, double clearance_m) {
+  const SceneGeometry geometry(m, d);
+  for (const auto& [key, pose] : {std::pair<const char*, planner::Pose4>{"start", scene.start}, {"goal", scene.goal}}) {
+    const double sd = geometry.signedDistance(pose.p_WB);
+    if (sd < clearance_m) {
+      std::ostringstream msg;
+      msg << scene.source.string() << ": key '" << key << "' = [" << pose.p_WB.x() << ", " << pose.p_WB.y() << ", "
+          << pose.p_WB.z() << "] is " << (sd < 0 ? "inside an obstacle" : "too close to an obstacle") << " ("
+          << sd << " m from the geometry, need " << clearance_m << " m)";
+      throw InputError(msg.str());
+    }
+  }
 }
 
 }  // namespace tgnav::harness

@@ -32,4 +32,10 @@ class SceneGeometry {
   std::vector<Shape> shapes_;
 };
 
+struct SceneConfig;
+
+// InputError naming the scene file, the key and the value if the start or the goal lies within
+// `clearance_m` of the scene's geometry (inside an obstacle, or touching one).
+void checkStartGoalFree(const SceneConfig& scene, const mjModel* m, const mjData* d, double clearance_m);
+
 }  // namespace tgnav::harness

@@ -35,14 +35,14 @@ void Topdown::drawMap(const planner::FeatureMap& map, double band_m) {
   image_.setTo(cv::Scalar(225, 225, 225), free);
   image_.setTo(cv::Scalar(60, 60, 60), occupied);
 
-  // Landmark density: count per pixel, blurred, log-scaled, drawn where there are landmarks.
+  // Landmark density: count per pixel, blurred over 5 cm, log-scaled, drawn where there are any.
   cv::Mat counts(image_.size(), CV_32FC1, cv::Scalar(0));
   for (int i = 0; i < static_cast<int>(map.landmarks().size()); ++i) {
     const cv::Point p = toPixel(map.landmarkVoxel(i).head<2>());
     if (p.x >= 0 && p.y >= 0 && p.x < counts.cols && p.y < counts.rows) counts.at<float>(p) += 1.0f;
   }
   cv::Mat density;
-  cv::GaussianBlur(counts, density, cv::Size(0, 0), 1.5);
+  cv::GaussianBlur(counts, density, cv::Size(0, 0), std::max(1.0, 0.05 / m_per_px_));
   double max_density = 0.0;
   cv::minMaxLoc(density, nullptr, &max_density);
   if (max_density <= 0.0) return;

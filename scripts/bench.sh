@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the Google Benchmark targets (build-bench/, Release) and prints one table of figures
-# with git SHA, host and date; writes the same as JSON to results/bench/bench.json.
+# with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
+# the feature map of every scene (results/bench/maps/) to time the mapping run.
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -8,23 +9,37 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="$root/build-bench"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTGNAV_BUILD_TESTS=OFF \
   -DTGNAV_BUILD_BENCHMARKS=ON >/dev/null
-cmake --build "$build" -j"$(nproc)" --target sim_benchmark >&2
+cmake --build "$build" -j"$(nproc)" --target sim_benchmark map_benchmark tgnav >&2
 out="$root/results/bench"
 mkdir -p "$out"
-"$build/tests/bench/sim_benchmark" --benchmark_out="$out/sim.json.tmp" \
-  --benchmark_out_format=json --benchmark_min_time=1 "$@" >&2
-mv "$out/sim.json.tmp" "$out/sim.json"
+for b in sim map; do
+  "$build/tests/bench/${b}_benchmark" --benchmark_out="$out/$b.json.tmp" \
+    --benchmark_out_format=json --benchmark_min_time=1 "$@" >&2
+  mv "$out/$b.json.tmp" "$out/$b.json"
+done
+# Map build time per scene: the whole mapping run of `tgnav map`.
+for yaml in "$root"/configs/scenes/*.yaml; do
+  name=$(basename "$yaml" .yaml)
+  [ "$name" = empty ] && continue
+  "$build/harness/tgnav" map --scene "$yaml" --out "$out/maps/$name" >&2
+done
 
 sha=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
 /usr/bin/python3 - "$out" "$sha" <<'PY'
 import json, os, socket, sys, datetime
 out, sha = sys.argv[1], sys.argv[2]
 rows = []
+maps = os.path.join(out, "maps")
+for scene in sorted(os.listdir(maps)) if os.path.isdir(maps) else []:
+    summary = json.load(open(os.path.join(maps, scene, "summary.json")))
+    rows.append({"benchmark": f"map_build/{scene}", "figure": "s_per_map", "value": summary["timing"]["total_s"]})
+    rows.append({"benchmark": f"map_build/{scene}", "figure": "landmarks", "value": summary["landmarks"]})
 for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "bench.json"):
     data = json.load(open(os.path.join(out, name)))
     for b in data["benchmarks"]:
         for key, value in b.items():
-            if key in ("ms_per_frame", "us_per_step", "us_per_cycle", "real_time_factor"):
+            if key in ("ms_per_frame", "us_per_step", "us_per_cycle", "real_time_factor", "queries_per_s",
+                       "landmarks_per_query"):
                 rows.append({"benchmark": b["name"], "figure": key, "value": value})
 meta = {"git_sha": sha, "host": socket.gethostname(), "cpus": os.cpu_count(),
         "date": datetime.datetime.now().isoformat(timespec="seconds")}

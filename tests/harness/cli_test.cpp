@@ -156,6 +156,55 @@ TEST(CliFly, ControllerConfigErrorsNameTheKey) {
   EXPECT_NE(run.output.find(yaml.string() + ": rates_hz.position = 300"), std::string::npos) << run.output;
 }
 
+// A copy of the smoke scene YAML with one line replaced.
+std::filesystem::path smokeWith(const std::filesystem::path& dir, const std::string& from, const std::string& to) {
+  std::ifstream in(smoke());
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text.replace(text.find(from), from.size(), to);
+  const std::string mjcf = (test::sourceDir() / "models/scenes/smoke.xml").string();
+  text.replace(text.find("../../models/scenes/smoke.xml"), 29, mjcf);
+  return test::writeFile(dir / "scene.yaml", text);
+}
+
+TEST(CliMap, StartInsideAnObstacleIsRejected) {
+  const auto dir = test::tempDir();
+  const auto yaml = smokeWith(dir, "start: [-3.0, 0.0, 1.0, 0.0]", "start: [0.1, 0.0, 1.0, 0.0]");
+  const CmdResult run = tgnav("map --scene " + yaml.string() + " --out " + (dir / "m").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("key 'start' = [0.1, 0, 1] is inside an obstacle"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m"));
+}
+
+TEST(CliMap, SurveyWithoutFreePosesIsRejected) {
+  const auto dir = test::tempDir();
+  const auto yaml = smokeWith(dir, "clearance_m: 0.45", "clearance_m: 9.0");
+  const CmdResult run = tgnav("map --scene " + yaml.string() + " --out " + (dir / "m").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("survey plan has no free pose"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "m"));
+}
+
+TEST(CliMap, RefusesToOverwriteSomethingElse) {
+  const auto dir = test::tempDir();
+  test::writeFile(dir / "precious.txt", "keep me");
+  const CmdResult run = tgnav("map --scene " + smoke() + " --out " + dir.string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_TRUE(std::filesystem::exists(dir / "precious.txt"));
+}
+
+TEST(CliMap, UnreadableTextureNamesTheMjcfAndTexture) {
+  const auto dir = test::tempDir();
+  const auto xml = test::writeFile(dir / "scene.xml",
+                                   "<mujoco><asset><texture name='t' type='cube' file='missing.png'/></asset></mujoco>");
+  const CmdResult run = tgnav("render --scene " + xml.string() + " --pose 0,0,1,0 --out " + (dir / "o").string());
+  EXPECT_EQ(run.rc, 2);
+  // MuJoCo 2.2 names the texture and its line, not the PNG's path.
+  EXPECT_NE(run.output.find(xml.string() + ": invalid MJCF"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("PNG file load error"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("Object name = t"), std::string::npos) << run.output;
+}
+
 TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
   const CmdResult bad = tgnav("fly-to-the-moon");
   EXPECT_EQ(bad.rc, 2);
