@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 
@@ -72,7 +73,12 @@ void runMap(const MapOptions& opt) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--resolution: ") + e.what());
   }
-  const std::filesystem::path out(opt.out);
+  const std::filesystem::path out = std::filesystem::absolute(opt.out).lexically_normal();
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  if (out == cwd || out == out.root_path() || !out.has_filename() ||
+      std::mismatch(out.begin(), out.end(), cwd.begin(), cwd.end()).first == out.end()) {
+    throw InputError("--out: '" + opt.out + "' is the working directory or one of its parents; name a new directory");
+  }
   if (std::filesystem::exists(out) && !std::filesystem::is_empty(out) &&
       !std::filesystem::exists(out / "summary.json")) {
     throw InputError(out.string() + ": exists and does not hold a previous map; choose another --out");

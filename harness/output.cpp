@@ -25,14 +25,16 @@ void writeFileAtomic(const std::filesystem::path& file, const std::string& conte
     out.write(content.data(), static_cast<std::streamsize>(content.size()));
     out.close();
     if (!out) {
-      std::filesystem::remove(tmp);
+      std::error_code ignored;
+      std::filesystem::remove(tmp, ignored);
       throw InputError(file.string() + ": cannot write file");
     }
   }
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);
   if (ec) {
-    std::filesystem::remove(tmp);
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
     throw InputError(file.string() + ": cannot write file: " + ec.message());
   }
 }

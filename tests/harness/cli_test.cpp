@@ -191,6 +191,9 @@ TEST(CliMap, RefusesToOverwriteSomethingElse) {
   const CmdResult run = tgnav("map --scene " + smoke() + " --out " + dir.string());
   EXPECT_EQ(run.rc, 2);
   EXPECT_TRUE(std::filesystem::exists(dir / "precious.txt"));
+  const CmdResult here = tgnav("map --scene " + smoke() + " --out .");
+  EXPECT_EQ(here.rc, 2);
+  EXPECT_NE(here.output.find("is the working directory"), std::string::npos) << here.output;
 }
 
 TEST(CliMap, UnreadableTextureNamesTheMjcfAndTexture) {
