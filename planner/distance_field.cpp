@@ -1,0 +1,101 @@
+#include "planner/distance_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tgnav::planner {
+
+namespace {
+constexpr double kInf = 1e20;
+}
+
+DistanceField::DistanceField(const OccupancyGrid2D& grid) : grid_(grid) {
+  const int w = grid.width + 2;
+  const int h = grid.height + 2;
+  auto occupied = [&](int px, int py) { return grid.isOccupied(px - 1, py - 1); };  // padding: outside = occupied
+  // Pass 1, along y: squared distance to the nearest occupied cell of the same column.
+  std::vector<double> g(static_cast<std::size_t>(w) * h, kInf);
+  std::vector<int> gy(static_cast<std::size_t>(w) * h, -1);
+  for (int x = 0; x < w; ++x) {
+    int last = -1;
+    for (int y = 0; y < h; ++y) {
+      if (occupied(x, y)) last = y;
+      if (last >= 0) {
+        g[static_cast<std::size_t>(y) * w + x] = static_cast<double>(y - last) * (y - last);
+        gy[static_cast<std::size_t>(y) * w + x] = last;
+      }
+    }
+    last = -1;
+    for (int y = h - 1; y >= 0; --y) {
+      if (occupied(x, y)) last = y;
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (last >= 0 && static_cast<double>(last - y) * (last - y) < g[i]) {
+        g[i] = static_cast<double>(last - y) * (last - y);
+        gy[i] = last;
+      }
+    }
+  }
+  // Pass 2, along x: lower envelope of the parabolas (x - q)^2 + g(q).
+  dist2_cells_.assign(static_cast<std::size_t>(w) * h, kInf);
+  site_.assign(static_cast<std::size_t>(w) * h, Eigen::Vector2i(-1, -1));
+  std::vector<int> v(w);
+  std::vector<double> z(w + 1);
+  for (int y = 0; y < h; ++y) {
+    const double* f = &g[static_cast<std::size_t>(y) * w];
+    int k = 0;
+    v[0] = 0;
+    z[0] = -kInf;
+    z[1] = kInf;
+    for (int q = 1; q < w; ++q) {
+      double s = 0.0;
+      while (true) {
+        const int p = v[k];
+        s = ((f[q] + static_cast<double>(q) * q) - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
+        if (s > z[k] || k == 0) break;
+        --k;
+      }
+      if (s <= z[k]) {  // k == 0 and the new parabola dominates everywhere
+        v[0] = q;
+        z[1] = kInf;
+        continue;
+      }
+      ++k;
+      v[k] = q;
+      z[k] = s;
+      z[k + 1] = kInf;
+    }
+    k = 0;
+    for (int x = 0; x < w; ++x) {
+      while (z[k + 1] < x) ++k;
+      const int q = v[k];
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      dist2_cells_[i] = static_cast<double>(x - q) * (x - q) + f[q];
+      site_[i] = Eigen::Vector2i(q - 1, gy[static_cast<std::size_t>(y) * w + q] - 1);
+    }
+  }
+}
+
+double DistanceField::centreDistance(int ix, int iy) const {
+  if (!grid_.inside(ix, iy)) return 0.0;
+  return std::sqrt(dist2_cells_[padded(ix, iy)]) * grid_.resolution_m;
+}
+
+Eigen::Vector2i DistanceField::nearestObstacle(int ix, int iy) const { return site_[padded(ix, iy)]; }
+
+double DistanceField::clearance(const Eigen::Vector2d& p_m) const {
+  const Eigen::Vector2i c = grid_.cellOf(p_m);
+  if (!grid_.inside(c.x(), c.y())) return -1.0;
+  return centreDistance(c.x(), c.y()) - grid_.resolution_m;
+}
+
+bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const {
+  const double len = (b - a).norm();
+  const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.25 * grid_.resolution_m))));
+  for (int i = 0; i <= steps; ++i) {
+    if (clearance(a + (b - a) * (static_cast<double>(i) / steps)) < clearance_m) return false;
+  }
+  return true;
+}
+
+}  // namespace tgnav::planner
