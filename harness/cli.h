@@ -10,6 +10,7 @@ namespace tgnav::cli {
 void addRenderCommand(CLI::App& app);
 void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
+void addPlanCommand(CLI::App& app);
 
 // Parses "a,b,c" into exactly `count` finite numbers; InputError naming `option` otherwise.
 std::vector<double> parseNumbers(const std::string& text, std::size_t count,

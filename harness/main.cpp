@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   tgnav::cli::addRenderCommand(app);
   tgnav::cli::addFlyCommand(app);
   tgnav::cli::addMapCommand(app);
+  tgnav::cli::addPlanCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

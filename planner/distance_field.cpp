@@ -85,15 +85,39 @@ Eigen::Vector2i DistanceField::nearestObstacle(int ix, int iy) const { return si
 
 double DistanceField::clearance(const Eigen::Vector2d& p_m) const {
   const Eigen::Vector2i c = grid_.cellOf(p_m);
-  if (!grid_.inside(c.x(), c.y())) return -1.0;
-  return centreDistance(c.x(), c.y()) - grid_.resolution_m;
+  if (grid_.isOccupied(c.x(), c.y())) return -1.0;
+  // The nearest obstacle cell of p is the nearest of its own cell or of a neighbour cell (the
+  // feature transform is exact at cell centres); measure to that cell's square exactly.
+  const double half = 0.5 * grid_.resolution_m;
+  double best = std::numeric_limits<double>::infinity();
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = c.x() + dx;
+      const int ny = c.y() + dy;
+      if (nx < -1 || ny < -1 || nx > grid_.width || ny > grid_.height) continue;
+      const Eigen::Vector2i site = site_[padded(nx, ny)];
+      const Eigen::Vector2d centre = grid_.centreOf(site.x(), site.y());
+      const Eigen::Vector2d d = ((p_m - centre).cwiseAbs().array() - half).cwiseMax(0.0);
+      best = std::min(best, d.norm());
+    }
+  }
+  return best;
 }
 
 bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const {
+  // Clearance is 1-Lipschitz: every point lies within h/2 of a sample spaced h apart, so
+  // samples with clearance >= clearance_m + h/2 prove the whole segment clear.
   const double len = (b - a).norm();
-  const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.25 * grid_.resolution_m))));
+  const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * grid_.resolution_m))));
+  const double need = clearance_m + 0.5 * len / steps;
+  // A point is at most 0.71 cells from its cell's centre and obstacle cells reach 0.5 cells
+  // from theirs: the centre distance less 1.21 cells bounds the clearance from below.
+  const double slack = 1.21 * grid_.resolution_m;
   for (int i = 0; i <= steps; ++i) {
-    if (clearance(a + (b - a) * (static_cast<double>(i) / steps)) < clearance_m) return false;
+    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(i) / steps);
+    const Eigen::Vector2i c = grid_.cellOf(p);
+    if (grid_.inside(c.x(), c.y()) && centreDistance(c.x(), c.y()) - slack >= need) continue;
+    if (clearance(p) < need) return false;
   }
   return true;
 }

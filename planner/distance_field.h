@@ -17,8 +17,8 @@ class DistanceField {
   // Distance in metres from the centre of cell (ix, iy) to the centre of the nearest occupied
   // cell (0 in occupied cells). Cells outside the grid: 0.
   double centreDistance(int ix, int iy) const;
-  // Conservative clearance of a point: the distance from its cell's centre to the nearest
-  // occupied cell's boundary, less half a cell for where the point lies in its cell.
+  // Clearance of a point: its distance to the boundary of the nearest occupied cell (negative
+  // inside an occupied cell or outside the map).
   double clearance(const Eigen::Vector2d& p_m) const;
   // Nearest occupied cell of (ix, iy), in grid coordinates (may be -1 or width/height: the
   // padding ring outside the map).

@@ -1,5 +1,7 @@
 #include "planner/feature_map.h"
 
+#include "planner/occupancy_grid.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -26,6 +28,33 @@ void VisibilityConfig::validate() const {
   if (!(vfov_rad > 0.0 && vfov_rad < M_PI)) fail("vfov_rad must be in (0, pi): vfov_rad", vfov_rad);
   if (!(min_range_m >= 0.0)) fail("min_range_m must be >= 0: min_range_m", min_range_m);
   if (!(max_range_m > min_range_m)) fail("max_range_m must exceed min_range_m: max_range_m", max_range_m);
+}
+
+OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min_xy, const Eigen::Vector2d& max_xy,
+                               double z_lo, double z_hi, double resolution_m) {
+  const Eigen::Vector2d extent = max_xy - min_xy;
+  OccupancyGrid2D grid(static_cast<int>(std::ceil(extent.x() / resolution_m - 1e-9)),
+                       static_cast<int>(std::ceil(extent.y() / resolution_m - 1e-9)), resolution_m, min_xy);
+  const double step = std::min(resolution_m, map.resolution()) * 0.5;
+  for (int iy = 0; iy < grid.height; ++iy) {
+    for (int ix = 0; ix < grid.width; ++ix) {
+      const Eigen::Vector2d c = grid.centreOf(ix, iy);
+      bool occupied = false;
+      bool unseen = false;
+      // Sample the cell's column at the map's resolution (cells may be larger than voxels).
+      for (double dx = -0.5 * resolution_m + 0.5 * step; dx < 0.5 * resolution_m && !occupied; dx += step) {
+        for (double dy = -0.5 * resolution_m + 0.5 * step; dy < 0.5 * resolution_m && !occupied; dy += step) {
+          for (double z = z_lo; z <= z_hi + 1e-9 && !occupied; z += map.resolution()) {
+            const Eigen::Vector3d p(c.x() + dx, c.y() + dy, z);
+            if (map.isOccupied(p)) occupied = true;
+            else if (!map.isKnown(p)) unseen = true;
+          }
+        }
+      }
+      grid.set(ix, iy, occupied || unseen);
+    }
+  }
+  return grid;
 }
 
 int hammingDistance(const std::array<std::uint8_t, 32>& a, const std::array<std::uint8_t, 32>& b) {

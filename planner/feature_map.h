@@ -76,6 +76,13 @@ class FeatureMap {
   std::unordered_map<octomap::OcTreeKey, std::vector<int>, octomap::OcTreeKey::KeyHash> by_voxel_;
 };
 
+// 2D occupancy slice of the map over [min_xy, max_xy] for heights [z_lo, z_hi] (the flight
+// height band): a cell is free when every voxel of its column in the band was observed free;
+// anything occupied or never observed (box interiors, missed patches of a crate's top) blocks it.
+struct OccupancyGrid2D;
+OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min_xy, const Eigen::Vector2d& max_xy,
+                               double z_lo, double z_hi, double resolution_m);
+
 // Number of differing bits between two ORB descriptors.
 int hammingDistance(const std::array<std::uint8_t, 32>& a, const std::array<std::uint8_t, 32>& b);
 

@@ -128,7 +128,9 @@ std::vector<Eigen::Vector2d> TopologicalPlanner::shorten(std::vector<Eigen::Vect
   // chord of its neighbours, only if the new segments keep the clearance and the triangle
   // swept holds no obstacle (so the path stays in its homology class).
   const double r = config_.robot_radius_m;
-  for (int sweep = 0; sweep < 100; ++sweep) {
+  // Relaxation converges geometrically; stop once a sweep gains less than a centimetre.
+  double length = polylineLength(pts);
+  for (int sweep = 0; sweep < 50; ++sweep) {
     bool changed = false;
     for (std::size_t i = 1; i + 1 < pts.size();) {
       const Eigen::Vector2d a = pts[i - 1];
@@ -142,14 +144,16 @@ std::vector<Eigen::Vector2d> TopologicalPlanner::shorten(std::vector<Eigen::Vect
       const Eigen::Vector2d ac = c - a;
       const double t_proj = std::clamp((b - a).dot(ac) / std::max(ac.squaredNorm(), 1e-12), 0.0, 1.0);
       const Eigen::Vector2d target = a + t_proj * ac;
+      auto movable = [&](double t) {
+        const Eigen::Vector2d m = b + t * (target - b);
+        return field_.segmentClear(a, m, r) && field_.segmentClear(m, c, r) && !obstacleInTriangle(a, b, m) &&
+               !obstacleInTriangle(b, c, m);
+      };
       double lo = 0.0;
       double hi = 1.0;
-      for (int it = 0; it < 10; ++it) {
+      for (int it = 0; it < 8; ++it) {
         const double mid = 0.5 * (lo + hi);
-        const Eigen::Vector2d m = b + mid * (target - b);
-        const bool ok = field_.segmentClear(a, m, r) && field_.segmentClear(m, c, r) &&
-                        !obstacleInTriangle(a, b, m) && !obstacleInTriangle(b, c, m);
-        (ok ? lo : hi) = mid;
+        (movable(mid) ? lo : hi) = mid;
       }
       if (lo * (target - b).norm() > 1e-3) {
         pts[i] = b + lo * (target - b);
@@ -157,7 +161,9 @@ std::vector<Eigen::Vector2d> TopologicalPlanner::shorten(std::vector<Eigen::Vect
       }
       ++i;
     }
-    if (!changed) break;
+    const double new_length = polylineLength(pts);
+    if (!changed || length - new_length < 1e-2) break;
+    length = new_length;
   }
   return pts;
 }

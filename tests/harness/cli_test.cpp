@@ -208,6 +208,55 @@ TEST(CliMap, UnreadableTextureNamesTheMjcfAndTexture) {
   EXPECT_NE(run.output.find("Object name = t"), std::string::npos) << run.output;
 }
 
+// A MovingAI map: 20 x 12 cells, two pillars in the middle row.
+std::filesystem::path twoPillars(const std::filesystem::path& dir) {
+  std::string text = "type octile\nheight 12\nwidth 20\nmap\n";
+  for (int r = 0; r < 12; ++r) {
+    std::string row(20, '.');
+    if (r >= 5 && r <= 6) {
+      row.replace(5, 2, "@@");
+      row.replace(13, 2, "@@");
+    }
+    text += row + "\n";
+  }
+  return test::writeFile(dir / "two.map", text);
+}
+
+TEST(CliPlan, GridPlanWritesClassesAndPicture) {
+  const auto dir = test::tempDir();
+  const CmdResult run = tgnav("plan --grid " + twoPillars(dir).string() + " --start 1.5,6 --goal 18.5,6 --out " +
+                              (dir / "p").string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("solved, 4 homology classes"), std::string::npos) << run.output;
+  std::ifstream json(dir / "p" / "plan.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  for (const char* key : {"\"classes\"", "\"h_signature\"", "\"waypoints\"", "\"chosen_class\": 0", "\"class_cap\": 10"}) {
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+  }
+  EXPECT_FALSE(cv::imread((dir / "p" / "plan.png").string()).empty());
+}
+
+TEST(CliPlan, BadStartIsOneLineExit2AndNoPathIsAResult) {
+  const auto dir = test::tempDir();
+  const auto map = twoPillars(dir);
+  CmdResult run = tgnav("plan --grid " + map.string() + " --start 5.5,5.5 --goal 18.5,6 --out " + (dir / "p").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("--start: '5.5,5.5'"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "p"));
+  // A wall of '@' across the map: planning succeeds in saying there is no path.
+  std::string walled = "type octile\nheight 6\nwidth 10\nmap\n";
+  for (int r = 0; r < 6; ++r) walled += "....@.....\n";
+  const auto wall = test::writeFile(dir / "wall.map", walled);
+  run = tgnav("plan --grid " + wall.string() + " --start 1.5,3 --goal 8.5,3 --out " + (dir / "w").string());
+  EXPECT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("no_path"), std::string::npos) << run.output;
+  run = tgnav("plan --grid " + map.string() + " --start 1.5,6 --goal 18.5,6 --planner proposed --out " +
+              (dir / "x").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("--planner: 'proposed'"), std::string::npos) << run.output;
+}
+
 TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
   const CmdResult bad = tgnav("fly-to-the-moon");
   EXPECT_EQ(bad.rc, 2);

@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "harness/map_builder.h"
+#include "planner/occupancy_grid.h"
 #include "harness/mujoco_sim.h"
 #include "harness/scene_geometry.h"
 #include "test_util.h"
@@ -144,6 +145,33 @@ TEST_F(SmokeMapTest, TexturedCratesCarryLandmarksThePlainPillarNone) {
   std::cout << "[ figure   ] landmarks on the plain pillar " << pillar << ", on textured crate_e1 " << crate << "\n";
   EXPECT_GT(crate, 500);
   EXPECT_LT(pillar * 20, crate);
+}
+
+TEST_F(SmokeMapTest, FlightHeightSliceMatchesTheGeometry) {
+  const double res = 0.1;
+  const double z = scene_->flight_height_m;
+  const planner::OccupancyGrid2D grid =
+      planner::sliceOccupancy(*map_, scene_->bounds_min_m.head<2>(), scene_->bounds_max_m.head<2>(), z - 0.3, z + 0.3, res);
+  int wrong_free = 0, wrong_occupied = 0, free_cells = 0, solid_cells = 0;
+  for (int iy = 0; iy < grid.height; ++iy) {
+    for (int ix = 0; ix < grid.width; ++ix) {
+      const Eigen::Vector2d c = grid.centreOf(ix, iy);
+      // Distance to geometry over the band (the smallest over three heights).
+      double sd = 1e9;
+      for (double dz : {-0.3, 0.0, 0.3}) sd = std::min(sd, geometry_->signedDistance({c.x(), c.y(), z + dz}));
+      if (sd < -res) {
+        ++solid_cells;
+        wrong_free += !grid.isOccupied(ix, iy);
+      } else if (sd > res) {
+        ++free_cells;
+        wrong_occupied += grid.isOccupied(ix, iy);
+      }
+    }
+  }
+  std::cout << "[ figure   ] smoke slice at flight height: " << wrong_free << "/" << solid_cells
+            << " solid cells free, " << wrong_occupied << "/" << free_cells << " free cells occupied\n";
+  EXPECT_EQ(wrong_free, 0);
+  EXPECT_LE(wrong_occupied, free_cells / 100);
 }
 
 }  // namespace
