@@ -10,16 +10,7 @@
 namespace tgnav::harness {
 namespace {
 
-// The message of the InputError that `fn` throws ("" when it throws none).
-template <typename Fn>
-std::string inputError(Fn fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using test::inputError;
 
 TEST(CameraConfigFile, ShippedFileEqualsBuiltInDefaults) {
   const CameraConfig file = loadCameraConfig(test::sourceDir() / "configs/camera.yaml");

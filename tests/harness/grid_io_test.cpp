@@ -14,17 +14,9 @@
 namespace tgnav::harness {
 namespace {
 
-using planner::OccupancyGrid2D;
+using test::inputError;
 
-template <typename Fn>
-std::string inputError(Fn fn) {
-  try {
-    fn();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using planner::OccupancyGrid2D;
 
 // The grid drawn top row first ('#' occupied, '.' free), so it reads like the image.
 std::vector<std::string> drawn(const OccupancyGrid2D& grid) {

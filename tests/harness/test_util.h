@@ -6,6 +6,8 @@
 #include <fstream>
 #include <string>
 
+#include "harness/errors.h"
+
 namespace tgnav::test {
 
 inline std::filesystem::path sourceDir() { return TGNAV_SOURCE_DIR; }
@@ -23,6 +25,17 @@ inline std::filesystem::path tempDir() {
 inline std::filesystem::path writeFile(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path) << text;
   return path;
+}
+
+// The message of the InputError that `fn` throws ("" when it throws none).
+template <typename Fn>
+std::string inputError(Fn fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace tgnav::test
