@@ -26,7 +26,6 @@ class ControlAllocator {
   Eigen::Vector4d wrenchOf(const ControlDemand& demand) const;
   // The normalised demand that commands `u` produce.
   ControlDemand achieved(const Eigen::VectorXd& u) const;
-  int rotorCount() const { return static_cast<int>(max_thrust_n_.size()); }
 
  private:
   void desaturate(Eigen::VectorXd& u, const Eigen::VectorXd& direction, double u_max,

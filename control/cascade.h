@@ -33,9 +33,6 @@ class Cascade {
   Eigen::VectorXd updateRate(const Eigen::Vector3d& w_B, double dt_s);
   void reset();
 
-  const AttitudeSetpoint& attitudeSetpoint() const { return attitude_sp_; }
-  const Eigen::Vector3d& rateSetpoint() const { return rate_sp_; }
-  const ControlAllocator& allocator() const { return allocator_; }
   const PositionControl& positionControl() const { return position_; }
 
  private:

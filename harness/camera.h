@@ -64,7 +64,6 @@ class Camera {
   // Pose of C in W for the current state of `d`.
   Eigen::Isometry3d pose(const mjData* d) const;
   const Intrinsics& intrinsics() const { return intrinsics_; }
-  int cameraId() const { return cam_id_; }
 
  private:
   const mjModel* model_;

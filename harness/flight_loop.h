@@ -38,7 +38,6 @@ class FlightLoop {
   bool positionUpdateDue() const { return steps_ % per_position_ == 0; }
   const std::string& divergence() const { return divergence_; }
   const control::VehicleParams& vehicle() const { return vehicle_; }
-  const control::Cascade& cascade() const { return cascade_; }
   // Thresholds of the divergence check.
   void setDivergenceLimits(double tilt_rad, double speed_m_s);
 

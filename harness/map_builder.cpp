@@ -128,12 +128,7 @@ void MapBuildConfig::validate() const {
   features.validate();
 }
 
-std::vector<planner::Pose4> surveyPoses(const SceneConfig& scene) {
-  ModelPtr model = loadModel(scene.mjcf);
-  DataPtr data = makeData(model.get());
-  mj_forward(model.get(), data.get());
-  checkStartGoalFree(scene, model.get(), data.get(), kVehicleRadiusM);
-  const SceneGeometry geometry(model.get(), data.get());
+std::vector<planner::Pose4> surveyPoses(const SceneConfig& scene, const SceneGeometry& geometry) {
   const SurveyPlan& plan = scene.survey;
   std::vector<planner::Pose4> poses;
   const Eigen::Vector3d lo = scene.bounds_min_m;
@@ -169,11 +164,13 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   config.validate();
   const auto t_start = Clock::now();
   MapBuildStats stats;
-  const std::vector<planner::Pose4> poses = surveyPoses(scene);
-  stats.survey_positions = static_cast<int>(poses.size()) / scene.survey.yaw_count;
-
   ModelPtr model = loadModel(scene.mjcf);
   DataPtr data = makeData(model.get());
+  mj_forward(model.get(), data.get());
+  const SceneGeometry geometry(model.get(), data.get());
+  checkStartGoalFree(scene, geometry, kVehicleRadiusM);
+  const std::vector<planner::Pose4> poses = surveyPoses(scene, geometry);
+  stats.survey_positions = static_cast<int>(poses.size()) / scene.survey.yaw_count;
   const VehicleIds ids = VehicleIds::find(model.get(), scene.mjcf.string());
   EglContext gl;
   Camera camera(model.get(), gl, config.camera, 0);

@@ -42,10 +42,12 @@ struct MapBuildStats {
   double total_s = 0.0;
 };
 
+class SceneGeometry;
+
 // Vehicle poses of the mapping run: grid positions over the scene bounds at every survey
 // height, kept where the static geometry is at least survey.clearance_m away, times
 // survey.yaw_count yaws. Deterministic order. InputError if none is free.
-std::vector<planner::Pose4> surveyPoses(const SceneConfig& scene);
+std::vector<planner::Pose4> surveyPoses(const SceneConfig& scene, const SceneGeometry& geometry);
 
 planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConfig& config,
                                     MapBuildStats* stats,

@@ -58,8 +58,7 @@ double SceneGeometry::distanceToSurface(const Eigen::Vector3d& p_W) const {
   return best;
 }
 
-void checkStartGoalFree(const SceneConfig& scene, const mjModel* m, const mjData* d, double clearance_m) {
-  const SceneGeometry geometry(m, d);
+void checkStartGoalFree(const SceneConfig& scene, const SceneGeometry& geometry, double clearance_m) {
   for (const auto& [key, pose] : {std::pair<const char*, planner::Pose4>{"start", scene.start}, {"goal", scene.goal}}) {
     const double sd = geometry.signedDistance(pose.p_WB);
     if (sd < clearance_m) {

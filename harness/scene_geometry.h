@@ -36,6 +36,6 @@ struct SceneConfig;
 
 // InputError naming the scene file, the key and the value if the start or the goal lies within
 // `clearance_m` of the scene's geometry (inside an obstacle, or touching one).
-void checkStartGoalFree(const SceneConfig& scene, const mjModel* m, const mjData* d, double clearance_m);
+void checkStartGoalFree(const SceneConfig& scene, const SceneGeometry& geometry, double clearance_m);
 
 }  // namespace tgnav::harness

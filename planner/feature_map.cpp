@@ -1,5 +1,6 @@
 #include "planner/feature_map.h"
 
+#include "planner/check.h"
 #include "planner/occupancy_grid.h"
 
 #include <algorithm>
@@ -19,15 +20,10 @@ Eigen::Vector3d toEigen(const octomap::point3d& p) { return Eigen::Vector3d(p.x(
 }  // namespace
 
 void VisibilityConfig::validate() const {
-  auto fail = [](const std::string& what, double v) {
-    std::ostringstream msg;
-    msg << what << " = " << v;
-    throw std::invalid_argument(msg.str());
-  };
-  if (!(hfov_rad > 0.0 && hfov_rad < M_PI)) fail("hfov_rad must be in (0, pi): hfov_rad", hfov_rad);
-  if (!(vfov_rad > 0.0 && vfov_rad < M_PI)) fail("vfov_rad must be in (0, pi): vfov_rad", vfov_rad);
-  if (!(min_range_m >= 0.0)) fail("min_range_m must be >= 0: min_range_m", min_range_m);
-  if (!(max_range_m > min_range_m)) fail("max_range_m must exceed min_range_m: max_range_m", max_range_m);
+  require(hfov_rad > 0.0 && hfov_rad < M_PI, "hfov_rad", hfov_rad, "must be in (0, pi)");
+  require(vfov_rad > 0.0 && vfov_rad < M_PI, "vfov_rad", vfov_rad, "must be in (0, pi)");
+  require(min_range_m >= 0.0, "min_range_m", min_range_m, "must be >= 0");
+  require(max_range_m > min_range_m, "max_range_m", max_range_m, "must exceed min_range_m");
 }
 
 OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min_xy, const Eigen::Vector2d& max_xy,

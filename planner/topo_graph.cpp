@@ -1,9 +1,10 @@
 #include "planner/topo_graph.h"
 
+#include "planner/check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <queue>
-#include <sstream>
 #include <stdexcept>
 
 namespace tgnav::planner {
@@ -109,12 +110,8 @@ void pruneSpurs(Mask& mask, double min_length_cells) {
 }  // namespace
 
 void GvdConfig::validate() const {
-  if (!(robot_radius_m >= 0.0) || !(min_spur_length_m >= 0.0)) {
-    std::ostringstream msg;
-    msg << "robot_radius_m = " << robot_radius_m << ", min_spur_length_m = " << min_spur_length_m
-        << ": must be >= 0";
-    throw std::invalid_argument(msg.str());
-  }
+  require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
+  require(min_spur_length_m >= 0.0, "min_spur_length_m", min_spur_length_m, "must be >= 0");
 }
 
 std::vector<std::uint8_t> computeGvd(const DistanceField& field, const GvdConfig& config) {

@@ -1,9 +1,10 @@
 #include "planner/topological_planner.h"
 
+#include "planner/check.h"
+
 #include <algorithm>
 #include <cmath>
 #include <queue>
-#include <sstream>
 #include <stdexcept>
 
 namespace tgnav::planner {
@@ -69,16 +70,11 @@ const char* toString(PlanStatus status) {
 }
 
 void TopoPlannerConfig::validate() const {
-  auto fail = [](const std::string& field, double v, const std::string& rule) {
-    std::ostringstream msg;
-    msg << field << " = " << v << ": " << rule;
-    throw std::invalid_argument(msg.str());
-  };
-  if (!(robot_radius_m >= 0.0)) fail("robot_radius_m", robot_radius_m, "must be >= 0");
-  if (!(min_spur_length_m >= 0.0)) fail("min_spur_length_m", min_spur_length_m, "must be >= 0");
-  if (max_classes < 1) fail("max_classes", max_classes, "must be >= 1");
-  if (max_expansions < 1) fail("max_expansions", max_expansions, "must be >= 1");
-  if (!(max_length_ratio >= 1.0)) fail("max_length_ratio", max_length_ratio, "must be >= 1");
+  require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
+  require(min_spur_length_m >= 0.0, "min_spur_length_m", min_spur_length_m, "must be >= 0");
+  require(max_classes >= 1, "max_classes", max_classes, "must be >= 1");
+  require(max_expansions >= 1, "max_expansions", max_expansions, "must be >= 1");
+  require(max_length_ratio >= 1.0, "max_length_ratio", max_length_ratio, "must be >= 1");
 }
 
 double polylineLength(const std::vector<Eigen::Vector2d>& path) {

@@ -53,7 +53,6 @@ class TopologicalPlanner {
   TopoPlan solve(const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m) const;
 
   const DistanceField& field() const { return field_; }
-  const std::vector<std::uint8_t>& skeleton() const { return skeleton_; }
   // Winding angles of a polyline around every obstacle component point.
   std::vector<double> hSignature(const std::vector<Eigen::Vector2d>& path) const;
   static bool sameClass(const std::vector<double>& a, const std::vector<double>& b);

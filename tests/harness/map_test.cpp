@@ -67,7 +67,7 @@ SceneGeometry* SmokeMapTest::geometry_ = nullptr;
 TEST_F(SmokeMapTest, SurveyCoversTheFreeSpace) {
   EXPECT_GT(stats_.survey_positions, 40);
   EXPECT_EQ(stats_.frames, stats_.survey_positions * scene_->survey.yaw_count);
-  for (const auto& pose : surveyPoses(*scene_)) {
+  for (const auto& pose : surveyPoses(*scene_, *geometry_)) {
     ASSERT_GE(geometry_->signedDistance(pose.p_WB), scene_->survey.clearance_m);
   }
 }
