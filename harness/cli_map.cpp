@@ -1,7 +1,5 @@
 // tgnav map: the mapping run of a scene -> occlusion-aware feature map on disk.
 #include <nlohmann/json.hpp>
-#include <fcntl.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -11,6 +9,7 @@
 #include "harness/errors.h"
 #include "harness/map_builder.h"
 #include "harness/output.h"
+#include "harness/quiet_stderr.h"
 #include "harness/topdown.h"
 
 namespace tgnav::cli {
@@ -21,29 +20,6 @@ struct MapOptions {
   std::string scene;
   std::string out;
   double resolution_m = 0.1;
-};
-
-// OctoMap's binary writer prints " done." on stderr; keep the program's output to its own lines.
-class QuietStderr {
- public:
-  QuietStderr() : saved_(dup(STDERR_FILENO)) {
-    const int null = open("/dev/null", O_WRONLY);
-    if (null >= 0) {
-      dup2(null, STDERR_FILENO);
-      close(null);
-    }
-  }
-  ~QuietStderr() {
-    if (saved_ >= 0) {
-      dup2(saved_, STDERR_FILENO);
-      close(saved_);
-    }
-  }
-  QuietStderr(const QuietStderr&) = delete;
-  QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  int saved_;
 };
 
 nlohmann::ordered_json summaryJson(const harness::SceneConfig& scene, const harness::MapBuildConfig& c,
@@ -95,7 +71,7 @@ void runMap(const MapOptions& opt) {
   std::filesystem::remove_all(tmp);
   harness::makeOutputDir(tmp);
   {
-    const QuietStderr quiet;
+    const harness::QuietStderr quiet;
     map.save(tmp);
   }
   // About 800 pixels across, whatever the scene's size.

@@ -1,5 +1,7 @@
-// tgnav plan --grid: topological planning on a 2D occupancy grid (ROS map_server or MovingAI).
+// tgnav plan: on a scene's feature map (--scenario: proposed, agnostic or rrtstar), or
+// topological planning on a 2D occupancy grid (--grid: ROS map_server or MovingAI).
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -9,7 +11,11 @@
 #include "harness/cli.h"
 #include "harness/errors.h"
 #include "harness/grid_io.h"
+#include "harness/map_cache.h"
 #include "harness/output.h"
+#include "harness/plan_run.h"
+#include "harness/quiet_stderr.h"
+#include "harness/scenario.h"
 #include "planner/topological_planner.h"
 
 namespace tgnav::cli {
@@ -18,9 +24,14 @@ namespace {
 
 struct PlanOptions {
   std::string grid;
+  std::string scenario;
   std::string start;
   std::string goal;
-  std::string planner = "agnostic";
+  std::string planner;
+  long long seed = -1;   // -1: the scenario's
+  int samples = 0;       // 0: planner.yaml's rrt_star.samples
+  std::string map;
+  std::string map_cache;
   std::string out;
   double resolution_m = 1.0;
   double robot_radius_m = 0.3;
@@ -76,7 +87,8 @@ cv::Mat drawPlan(const planner::OccupancyGrid2D& grid, const planner::TopoPlan& 
 }
 
 void runPlanGrid(const PlanOptions& opt) {
-  if (opt.planner != "agnostic") {
+  if (opt.start.empty() || opt.goal.empty()) throw InputError("--grid needs --start X,Y and --goal X,Y");
+  if (!opt.planner.empty() && opt.planner != "agnostic") {
     throw InputError("--planner: '" + opt.planner + "' needs a scene's feature map; with --grid only 'agnostic' runs");
   }
   planner::TopoPlannerConfig config;
@@ -107,7 +119,7 @@ void runPlanGrid(const PlanOptions& opt) {
   }
 
   nlohmann::ordered_json j;
-  j["planner"] = opt.planner;
+  j["planner"] = "agnostic";
   j["status"] = planner::toString(plan.status);
   j["plan_time_s"] = plan_s;
   j["map"] = {{"file", opt.grid}, {"width", grid.width}, {"height", grid.height},
@@ -139,20 +151,87 @@ void runPlanGrid(const PlanOptions& opt) {
   }
 }
 
+// The scene's feature map: --map DIR as given, else the cache (built on first use).
+planner::FeatureMap loadSceneMap(const PlanOptions& opt, const harness::Scenario& scenario) {
+  std::filesystem::path dir = opt.map;
+  if (dir.empty()) {
+    const std::filesystem::path cache = opt.map_cache.empty() ? harness::defaultCacheDir() : std::filesystem::path(opt.map_cache);
+    const bool tty = isatty(fileno(stderr)) != 0;
+    const harness::CachedMap cached =
+        harness::cachedFeatureMap(scenario.scene, harness::MapBuildConfig{}, cache, [&](int done, int total) {
+          if (tty && (done % 20 == 0 || done == total)) std::fprintf(stderr, "\rtgnav plan: mapping %d/%d frames", done, total);
+        });
+    if (tty && cached.built) std::fprintf(stderr, "\n");
+    dir = cached.dir;
+  }
+  try {
+    const harness::QuietStderr quiet;
+    return planner::FeatureMap::load(dir);
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string("--map: ") + e.what());
+  }
+}
+
+void runPlanScenario(const PlanOptions& opt) {
+  if (!opt.start.empty() || !opt.goal.empty()) {
+    throw InputError("--start/--goal: with --scenario, start and goal come from the scenario or its scene");
+  }
+  const harness::PlannerName name = harness::parsePlannerName(opt.planner.empty() ? "proposed" : opt.planner, "--planner");
+  if (opt.samples != 0 && name != harness::PlannerName::kRrtStar) {
+    throw InputError("--samples: only the rrtstar planner takes a sample budget");
+  }
+  if (opt.samples < 0) throw InputError("--samples: " + std::to_string(opt.samples) + " must be >= 1");
+  if (opt.seed < -1) throw InputError("--seed: " + std::to_string(opt.seed) + " must be >= 0");
+  const harness::Scenario scenario = harness::loadScenario(opt.scenario);
+  const std::uint64_t seed = opt.seed >= 0 ? static_cast<std::uint64_t>(opt.seed) : scenario.seed;
+  const std::filesystem::path out(opt.out);
+  harness::makeOutputDir(out);
+  const planner::FeatureMap map = loadSceneMap(opt, scenario);
+  const harness::PlanRun run = harness::runPlanner(scenario, map, name, seed, opt.samples);
+  harness::writeFileAtomic(out / "plan.json", harness::planJson(scenario, run).dump(2) + "\n");
+  harness::writeImageAtomic(out / "plan.png", harness::drawPlanImage(scenario, map, run));
+  const planner::Plan& plan = run.report.plan;
+  if (plan.chosen >= 0) {
+    const planner::CandidatePath& c = plan.candidates[static_cast<std::size_t>(plan.chosen)];
+    std::printf("tgnav plan: %s %s, %zu homology classes, chose class %d (%.2f m, c_p,min %.1f), %.3f s -> "
+                "%s/{plan.json,plan.png}\n",
+                harness::toString(name), planner::toString(plan.status), run.report.topo.classes.size(),
+                run.chosen_topology_class, c.length_m, c.c_p_min, run.plan_time_s(), out.string().c_str());
+  } else {
+    std::printf("tgnav plan: %s %s (no path from start to goal), %.3f s -> %s/{plan.json,plan.png}\n",
+                harness::toString(name), planner::toString(plan.status), run.plan_time_s(), out.string().c_str());
+  }
+}
+
 }  // namespace
 
 void addPlanCommand(CLI::App& app) {
   auto opt = std::make_shared<PlanOptions>();
-  CLI::App* cmd = app.add_subcommand("plan", "Plan paths in distinct homology classes on a 2D occupancy grid");
-  cmd->add_option("--grid", opt->grid, "ROS map_server .yaml (+ .pgm) or MovingAI .map")->required();
-  cmd->add_option("--start", opt->start, "Start X,Y in metres (map frame, y up)")->required();
-  cmd->add_option("--goal", opt->goal, "Goal X,Y in metres (map frame, y up)")->required();
-  cmd->add_option("--planner", opt->planner, "Planner; with --grid: agnostic (the shortest class)")->capture_default_str();
-  cmd->add_option("--resolution", opt->resolution_m, "Metres per cell of a MovingAI map")->capture_default_str();
-  cmd->add_option("--robot-radius", opt->robot_radius_m, "Clearance kept from obstacles, metres")->capture_default_str();
-  cmd->add_option("--max-classes", opt->max_classes, "Cap on the homology classes searched")->capture_default_str();
+  CLI::App* cmd = app.add_subcommand(
+      "plan", "Plan on a scene's feature map (--scenario) or on a 2D occupancy grid (--grid); writes plan.json, plan.png");
+  auto* scenario = cmd->add_option("--scenario", opt->scenario, "Scenario YAML (configs/scenarios/*.yaml)");
+  auto* grid = cmd->add_option("--grid", opt->grid, "ROS map_server .yaml (+ .pgm) or MovingAI .map");
+  scenario->excludes(grid);
+  cmd->add_option("--planner", opt->planner,
+                  "proposed | agnostic | rrtstar (default: proposed with --scenario, agnostic with --grid)");
+  cmd->add_option("--samples", opt->samples, "rrtstar: iteration budget N (default: planner config)");
+  cmd->add_option("--seed", opt->seed, "Random seed (default: the scenario's)");
+  cmd->add_option("--map", opt->map, "Feature map folder from `tgnav map` (default: cached by content)");
+  cmd->add_option("--map-cache", opt->map_cache, "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
+  cmd->add_option("--start", opt->start, "--grid: start X,Y in metres (map frame, y up)");
+  cmd->add_option("--goal", opt->goal, "--grid: goal X,Y in metres (map frame, y up)");
+  cmd->add_option("--resolution", opt->resolution_m, "--grid: metres per cell of a MovingAI map")->capture_default_str();
+  cmd->add_option("--robot-radius", opt->robot_radius_m, "--grid: clearance kept from obstacles, metres")->capture_default_str();
+  cmd->add_option("--max-classes", opt->max_classes, "--grid: cap on the homology classes searched")->capture_default_str();
   cmd->add_option("--out", opt->out, "Output directory")->required();
-  cmd->callback([opt] { runPlanGrid(*opt); });
+  cmd->callback([opt] {
+    if (opt->scenario.empty() == opt->grid.empty()) throw InputError("plan: give one of --scenario FILE or --grid MAP");
+    if (opt->grid.empty()) {
+      runPlanScenario(*opt);
+    } else {
+      runPlanGrid(*opt);
+    }
+  });
 }
 
 }  // namespace tgnav::cli

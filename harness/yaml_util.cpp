@@ -128,6 +128,18 @@ FieldReader& FieldReader::read(const std::string& key, int& out) {
   return *this;
 }
 
+FieldReader& FieldReader::read(const std::string& key, bool& out) {
+  known_.push_back(key);
+  if (!map_[key]) return *this;
+  const YAML::Node node = map_[key];
+  if (!node.IsScalar() || (node.Scalar() != "true" && node.Scalar() != "false")) {
+    doc_.fail(node, "key '" + joinKey(context_, key) + "' has value '" + (node.IsScalar() ? node.Scalar() : "<not a scalar>") +
+                        "', expected true or false");
+  }
+  out = node.Scalar() == "true";
+  return *this;
+}
+
 FieldReader& FieldReader::read(const std::string& key, std::string& out) {
   known_.push_back(key);
   if (map_[key]) out = doc_.string(map_, key, context_);

@@ -46,6 +46,7 @@ class FieldReader {
   FieldReader(const YamlDoc& doc, YAML::Node map, std::string context);
   FieldReader& read(const std::string& key, double& out);
   FieldReader& read(const std::string& key, int& out);
+  FieldReader& read(const std::string& key, bool& out);
   FieldReader& read(const std::string& key, std::string& out);
   FieldReader& read(const std::string& key, Eigen::Vector3d& out);
   // A nested mapping, when present (the callback reads it with its own FieldReader).

@@ -1,5 +1,7 @@
 #include "planner/distance_field.h"
 
+#include "planner/edt.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -39,40 +41,12 @@ DistanceField::DistanceField(const OccupancyGrid2D& grid) : grid_(grid) {
   // Pass 2, along x: lower envelope of the parabolas (x - q)^2 + g(q).
   dist2_cells_.assign(static_cast<std::size_t>(w) * h, kInf);
   site_.assign(static_cast<std::size_t>(w) * h, Eigen::Vector2i(-1, -1));
-  std::vector<int> v(w);
-  std::vector<double> z(w + 1);
+  EnvelopeScratch scratch;
+  std::vector<int> arg(w);
   for (int y = 0; y < h; ++y) {
-    const double* f = &g[static_cast<std::size_t>(y) * w];
-    int k = 0;
-    v[0] = 0;
-    z[0] = -kInf;
-    z[1] = kInf;
-    for (int q = 1; q < w; ++q) {
-      double s = 0.0;
-      while (true) {
-        const int p = v[k];
-        s = ((f[q] + static_cast<double>(q) * q) - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
-        if (s > z[k] || k == 0) break;
-        --k;
-      }
-      if (s <= z[k]) {  // k == 0 and the new parabola dominates everywhere
-        v[0] = q;
-        z[1] = kInf;
-        continue;
-      }
-      ++k;
-      v[k] = q;
-      z[k] = s;
-      z[k + 1] = kInf;
-    }
-    k = 0;
-    for (int x = 0; x < w; ++x) {
-      while (z[k + 1] < x) ++k;
-      const int q = v[k];
-      const std::size_t i = static_cast<std::size_t>(y) * w + x;
-      dist2_cells_[i] = static_cast<double>(x - q) * (x - q) + f[q];
-      site_[i] = Eigen::Vector2i(q - 1, gy[static_cast<std::size_t>(y) * w + q] - 1);
-    }
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    lowerEnvelope(&g[row], w, &dist2_cells_[row], arg.data(), &scratch);
+    for (int x = 0; x < w; ++x) site_[row + x] = Eigen::Vector2i(arg[x] - 1, gy[row + arg[x]] - 1);
   }
 }
 
@@ -110,9 +84,9 @@ bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d
   const double len = (b - a).norm();
   const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * grid_.resolution_m))));
   const double need = clearance_m + 0.5 * len / steps;
-  // A point is at most 0.71 cells from its cell's centre and obstacle cells reach 0.5 cells
-  // from theirs: the centre distance less 1.21 cells bounds the clearance from below.
-  const double slack = 1.21 * grid_.resolution_m;
+  // A point is at most 0.71 cells from its cell's centre and an obstacle cell's square reaches
+  // 0.71 cells from its own: the centre distance less 1.42 cells bounds the clearance from below.
+  const double slack = 1.4143 * grid_.resolution_m;
   for (int i = 0; i <= steps; ++i) {
     const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(i) / steps);
     const Eigen::Vector2i c = grid_.cellOf(p);

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the Google Benchmark targets (build-bench/, Release) and prints one table of figures
 # with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
-# the feature map of every scene (results/bench/maps/) to time the mapping run.
+# the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
+# storage and gallery with every planner (results/bench/plans/).
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -24,6 +25,24 @@ for yaml in "$root"/configs/scenes/*.yaml; do
   "$build/harness/tgnav" map --scene "$yaml" --out "$out/maps/$name" >&2
 done
 
+# Plan time per planner on the paper's scenes (Table II): the proposed planner and AP over three
+# seeds, perception-aware RRT* at the paper's sample counts (one seed each).
+rm -rf "$out/plans"
+for scene in storage gallery; do
+  map="$out/maps/$scene"
+  for seed in 1 2 3; do
+    for planner in proposed agnostic; do
+      "$build/harness/tgnav" plan --scenario "$root/configs/scenarios/$scene.yaml" --map "$map" \
+        --planner "$planner" --seed "$seed" --out "$out/plans/$scene-$planner-s$seed" >&2
+    done
+  done
+  if [ "$scene" = storage ]; then samples="300 1000 2000"; else samples="1000 8000 15000"; fi
+  for n in $samples; do
+    "$build/harness/tgnav" plan --scenario "$root/configs/scenarios/$scene.yaml" --map "$map" \
+      --planner rrtstar --samples "$n" --seed 1 --out "$out/plans/$scene-rrtstar$n-s1" >&2
+  done
+done
+
 sha=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
 /usr/bin/python3 - "$out" "$sha" <<'PY'
 import json, os, socket, sys, datetime
@@ -34,6 +53,15 @@ for scene in sorted(os.listdir(maps)) if os.path.isdir(maps) else []:
     summary = json.load(open(os.path.join(maps, scene, "summary.json")))
     rows.append({"benchmark": f"map_build/{scene}", "figure": "s_per_map", "value": summary["timing"]["total_s"]})
     rows.append({"benchmark": f"map_build/{scene}", "figure": "landmarks", "value": summary["landmarks"]})
+plans = os.path.join(out, "plans")
+groups = {}
+for run in sorted(os.listdir(plans)) if os.path.isdir(plans) else []:
+    plan = json.load(open(os.path.join(plans, run, "plan.json")))
+    groups.setdefault(run.rsplit("-s", 1)[0], []).append(plan)
+for key, runs in groups.items():
+    times = sorted(p["plan_time_s"] for p in runs)
+    rows.append({"benchmark": f"plan/{key}", "figure": "median_plan_s", "value": times[len(times) // 2]})
+    rows.append({"benchmark": f"plan/{key}", "figure": "path_length_m", "value": runs[0]["path_length_m"]})
 for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "bench.json"):
     data = json.load(open(os.path.join(out, name)))
     for b in data["benchmarks"]:

@@ -10,6 +10,8 @@ packages=(
   libmujoco-dev libqhull-dev          # MuJoCo 2.2 (its CMake target names qhull's include dir)
   libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri   # headless EGL, llvmpipe software GL
   libeigen3-dev libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev liboctomap-dev
+  libompl-dev libtbb-dev              # RRT* baseline; homology classes evaluated in parallel
+  libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL's CMake links these
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 

@@ -1,7 +1,7 @@
 // The paper's scenes say what the paper says, measured on feature maps built from rendering:
 // in storage the lower route sees far more landmarks than the upper one; in gallery the two
-// texture-poor corridors see far fewer than the textured ones. (One test per scene: each
-// builds its map once.)
+// texture-poor corridors see far fewer than the textured ones. (The maps come from the tests'
+// shared cache, see scene_cache_setup.cpp.)
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -32,7 +32,7 @@ double meanVisible(const planner::FeatureMap& map, const std::vector<Eigen::Vect
 
 TEST(SceneMaps, StorageLowerRouteSeesFiveTimesTheLandmarksOfTheUpperRoute) {
   const SceneConfig scene = loadSceneConfig(test::sourceDir() / "configs/scenes/storage.yaml");
-  const planner::FeatureMap map = buildFeatureMap(scene, MapBuildConfig{}, nullptr);
+  const planner::FeatureMap map = test::sceneMap("storage");
   const double z = scene.flight_height_m;
   // The middle stretches of the two routes around the partition (the ends are shared).
   const double upper = meanVisible(map, {{-3.6, 3.8}, {3.6, 3.8}}, z);
@@ -45,7 +45,7 @@ TEST(SceneMaps, StorageLowerRouteSeesFiveTimesTheLandmarksOfTheUpperRoute) {
 
 TEST(SceneMaps, GalleryTexturePoorCorridorsSeeFewLandmarks) {
   const SceneConfig scene = loadSceneConfig(test::sourceDir() / "configs/scenes/gallery.yaml");
-  const planner::FeatureMap map = buildFeatureMap(scene, MapBuildConfig{}, nullptr);
+  const planner::FeatureMap map = test::sceneMap("gallery");
   const double z = scene.flight_height_m;
   // Inside (not at the mouths of) the texture-poor corridors: the horizontal one right of the
   // centre (x 0.8..7.6, y 0..2.4) and the longitudinal one in the upper middle (x -1.7..0.8).

@@ -7,6 +7,9 @@
 #include <string>
 
 #include "harness/errors.h"
+#include "harness/map_cache.h"
+#include "harness/quiet_stderr.h"
+#include "planner/feature_map.h"
 
 namespace tgnav::test {
 
@@ -36,6 +39,15 @@ std::string inputError(Fn fn) {
     return e.what();
   }
   return "";
+}
+
+// The feature map of configs/scenes/<name>.yaml from the tests' shared cache (built by the
+// scene_maps fixture, or here on first use).
+inline planner::FeatureMap sceneMap(const std::string& name) {
+  const harness::SceneConfig scene = harness::loadSceneConfig(sourceDir() / "configs/scenes" / (name + ".yaml"));
+  const harness::CachedMap cached = harness::cachedFeatureMap(scene, harness::MapBuildConfig{}, TGNAV_TEST_CACHE);
+  const harness::QuietStderr quiet;
+  return planner::FeatureMap::load(cached.dir);
 }
 
 }  // namespace tgnav::test

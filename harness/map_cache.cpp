@@ -1,0 +1,118 @@
+#include "harness/map_cache.h"
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <vector>
+
+#include "harness/errors.h"
+#include "harness/mujoco_sim.h"
+#include "harness/output.h"
+#include "harness/quiet_stderr.h"
+
+namespace tgnav::harness {
+
+namespace {
+
+// FNV-1a, 64 bit: stable across runs and machines (std::hash is not).
+class Fnv1a {
+ public:
+  void add(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ p[i]) * 0x100000001b3ULL;
+  }
+  void add(const std::string& s) { add(s.data(), s.size()); }
+  std::uint64_t value() const { return h_; }
+
+ private:
+  std::uint64_t h_ = 0xcbf29ce484222325ULL;
+};
+
+std::string settingsText(const SceneConfig& scene, const MapBuildConfig& c) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "tgnav-map-v1\n"
+    << scene.bounds_min_m.transpose() << ' ' << scene.bounds_max_m.transpose() << '\n'
+    << scene.survey.spacing_m << ' ' << scene.survey.yaw_count << ' ' << scene.survey.clearance_m;
+  for (double h : scene.survey.heights_m) s << ' ' << h;
+  s << '\n'
+    << c.resolution_m << ' ' << c.max_range_m << ' ' << c.occupancy_stride_px << ' ' << c.merge_radius_m << ' '
+    << c.max_hamming << ' ' << c.min_observations << ' ' << c.max_shift_m << ' ' << c.depth_edge_m << '\n'
+    << c.camera.name << ' ' << c.camera.width_px << ' ' << c.camera.height_px << ' ' << c.camera.near_clip_m << ' '
+    << c.camera.far_clip_m << ' ' << c.camera.min_depth_m << ' ' << c.camera.max_depth_m << ' '
+    << c.camera.rgb_noise_sigma << ' ' << c.camera.depth_noise_sigma_per_m2 << '\n'
+    << c.features.max_features << ' ' << c.features.grid_cols << ' ' << c.features.grid_rows << ' '
+    << c.features.fast_threshold << ' ' << c.features.scale_factor << ' ' << c.features.pyramid_levels << ' '
+    << c.features.edge_threshold_px << '\n';
+  return s.str();
+}
+
+}  // namespace
+
+std::filesystem::path defaultCacheDir() {
+  if (const char* d = std::getenv("TGNAV_CACHE_DIR"); d != nullptr && *d != '\0') return d;
+  if (const char* d = std::getenv("XDG_CACHE_HOME"); d != nullptr && *d != '\0') {
+    return std::filesystem::path(d) / "tgnav";
+  }
+  if (const char* d = std::getenv("HOME"); d != nullptr && *d != '\0') {
+    return std::filesystem::path(d) / ".cache" / "tgnav";
+  }
+  throw InputError("no cache directory: set TGNAV_CACHE_DIR or HOME, or pass --map-cache");
+}
+
+std::string mapKey(const SceneConfig& scene, const MapBuildConfig& config) {
+  Fnv1a h;
+  h.add(settingsText(scene, config));
+  // The compiled model holds the geometry, materials and decoded textures: what the camera sees.
+  const ModelPtr model = loadModel(scene.mjcf);
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(mj_sizeModel(model.get())));
+  mj_saveModel(model.get(), nullptr, bytes.data(), static_cast<int>(bytes.size()));
+  h.add(bytes.data(), bytes.size());
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.value()));
+  return hex;
+}
+
+CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& config,
+                           const std::filesystem::path& cache_root,
+                           const std::function<void(int done, int total)>& progress) {
+  const std::string stem = scene.source.stem().string();
+  CachedMap out;
+  out.dir = cache_root / "maps" / (stem + "-" + mapKey(scene, config));
+  if (std::filesystem::is_regular_file(out.dir / "summary.json")) return out;
+
+  std::error_code ec;
+  std::filesystem::create_directories(out.dir.parent_path(), ec);
+  if (ec) throw InputError("map cache " + out.dir.parent_path().string() + ": cannot create (" + ec.message() + ")");
+  MapBuildStats stats;
+  const planner::FeatureMap map = buildFeatureMap(scene, config, &stats, progress);
+  const std::filesystem::path tmp = out.dir.string() + ".partial-" + std::to_string(getpid());
+  std::filesystem::remove_all(tmp);
+  makeOutputDir(tmp);
+  {
+    const QuietStderr quiet;
+    map.save(tmp);
+  }
+  nlohmann::ordered_json j;
+  j["scene"] = scene.source.string();
+  j["landmarks"] = stats.landmarks;
+  j["frames"] = stats.frames;
+  j["build_s"] = stats.total_s;
+  writeFileAtomic(tmp / "summary.json", j.dump(2) + "\n");
+  std::filesystem::rename(tmp, out.dir, ec);
+  if (ec) {
+    // Another process finished first: keep its map.
+    std::filesystem::remove_all(tmp);
+    if (!std::filesystem::is_regular_file(out.dir / "summary.json")) {
+      throw std::runtime_error("map cache " + out.dir.string() + ": cannot store the map (" + ec.message() + ")");
+    }
+    return out;
+  }
+  out.built = true;
+  return out;
+}
+
+}  // namespace tgnav::harness

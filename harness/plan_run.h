@@ -1,0 +1,45 @@
+#pragma once
+// One planning run on a scene's feature map (the "plan" stage of `tgnav plan` and `tgnav trial`):
+// the dense voxel map, then the chosen planner, timed, and its plan.json and plan.png.
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "harness/scenario.h"
+#include "planner/feature_map.h"
+#include "planner/perception_planner.h"
+#include "planner/voxel_map.h"
+
+namespace tgnav::harness {
+
+enum class PlannerName { kProposed, kAgnostic, kRrtStar };
+// "proposed" | "agnostic" | "rrtstar"; InputError naming `option` otherwise.
+PlannerName parsePlannerName(const std::string& text, const std::string& option);
+const char* toString(PlannerName name);
+
+struct PlanRun {
+  PlannerName planner = PlannerName::kProposed;
+  std::uint64_t seed = 0;
+  int rrt_samples = 0;                       // rrtstar only
+  planner::PerceptionPlanReport report;      // plan, topological classes, per-class details
+  int chosen_topology_class = -1;            // class of the chosen path among report.topo.classes
+  std::unique_ptr<planner::VoxelMap> voxels;
+  double voxel_map_s = 0.0;                  // wall time: dense voxel map + distance field
+  double solve_s = 0.0;                      // wall time: the planner itself
+  double plan_time_s() const { return voxel_map_s + solve_s; }
+};
+
+// Box of the dense voxel map: the scene's bounds widened by `margin_m` (walls lie just outside
+// the free-space bounds and must be inside the box to be seen and avoided).
+PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, PlannerName name, std::uint64_t seed,
+                   int rrt_samples);
+
+nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
+// Map, every class coloured by perception quality (c_p,min vs c_p,thr), the chosen 4-DoF path
+// with yaw arrows, start and goal.
+cv::Mat drawPlanImage(const Scenario& scenario, const planner::FeatureMap& map, const PlanRun& run);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,24 @@
+#pragma once
+// configs/planner.yaml -> the planners' Config structs (strict keys; defaults are Table I).
+#include <filesystem>
+
+#include "harness/yaml_util.h"
+#include "planner/perception_planner.h"
+#include "planner/rrt_star.h"
+
+namespace tgnav::harness {
+
+struct PlannerSettings {
+  planner::PerceptionPlannerConfig perception;  // proposed and agnostic
+  planner::RrtStarConfig rrt_star;              // its visibility, information and robot radius
+                                                // follow `perception`'s (one sensor, one robot)
+  void validate() const;                        // std::invalid_argument naming the key
+};
+
+// Reads the keys present in `r` (a planner.yaml root or a scenario's `planner:` section) over `s`.
+void readPlannerSettings(FieldReader r, PlannerSettings* s);
+PlannerSettings loadPlannerSettings(const std::filesystem::path& yaml, PlannerSettings base = {});
+// Re-raises validate() failures as InputError naming `source`.
+void validatePlannerSettings(const PlannerSettings& s, const std::string& source);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,56 @@
+#include "planner/perception.h"
+
+#include <cmath>
+#include <map>
+
+#include "planner/check.h"
+
+namespace tgnav::planner {
+
+void InformationConfig::validate() const {
+  require(bearing_noise_rad > 0.0, "bearing_noise_rad", bearing_noise_rad, "must be > 0");
+  require(epsilon > 0.0, "information_epsilon", epsilon, "must be > 0");
+}
+
+std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
+  std::map<int, int> count;
+  for (int id : ids) {
+    const int slot = voxels.landmarkSlot(id);
+    if (slot >= 0) ++count[slot];
+  }
+  std::vector<WeightedPoint> points;
+  points.reserve(count.size());
+  for (const auto& [slot, n] : count) {
+    points.push_back({voxels.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W, static_cast<double>(n)});
+  }
+  return points;
+}
+
+bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
+                   const VisibilityConfig& visibility) {
+  const Eigen::Vector3d d = l_W - p_W;
+  const double range = d.norm();
+  if (range < visibility.min_range_m || range > visibility.max_range_m) return false;
+  const double horizontal = d.head<2>().norm();
+  if (std::atan2(std::abs(d.z()), horizontal) > 0.5 * visibility.vfov_rad) return false;
+  const double bearing = std::remainder(std::atan2(d.y(), d.x()) - yaw_rad, 2.0 * M_PI);
+  return std::abs(bearing) <= 0.5 * visibility.hfov_rad;
+}
+
+Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
+                         const VisibilityConfig& visibility, const InformationConfig& config) {
+  Matrix6d info = Matrix6d::Zero();
+  for (const WeightedPoint& pt : points) {
+    if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility)) {
+      addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
+    }
+  }
+  return info;
+}
+
+double poseScore(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
+                 const VisibilityConfig& visibility, const InformationConfig& config) {
+  return logDetInformation(poseInformation(p_W, yaw_rad, points, visibility, config), config.epsilon);
+}
+
+}  // namespace tgnav::planner

@@ -1,0 +1,180 @@
+#include "planner/perception_planner.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "planner/check.h"
+
+namespace tgnav::planner {
+
+namespace {
+
+// SplitMix64: an independent, reproducible seed per class from the plan's seed.
+std::uint64_t classSeed(std::uint64_t seed, std::size_t index) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (index + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+std::vector<Eigen::Vector3d> lift(const std::vector<Eigen::Vector2d>& path, double z) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(path.size());
+  for (const auto& p : path) out.emplace_back(p.x(), p.y(), z);
+  return out;
+}
+
+// AP's 4-DoF path: the class's path with the yaw along the direction of travel.
+std::vector<Pose4> headingPath(const std::vector<Eigen::Vector3d>& path, double start_yaw) {
+  std::vector<Pose4> out;
+  double yaw = start_yaw;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    if (i + 1 < path.size()) d = path[i + 1] - path[i];
+    else if (i > 0) d = path[i] - path[i - 1];
+    if (d.head<2>().norm() > 1e-9) yaw = std::atan2(d.y(), d.x());
+    out.push_back({path[i], yaw});
+  }
+  return out;
+}
+
+// c_p of every segment (eq. 8 over the chosen poses in it); a segment shorter than the layer
+// spacing that holds no layer takes the layer nearest to its middle.
+std::vector<ScoredSegment> scoreSegments(const std::vector<PathSegment>& segments, const PoseGraphResult& graph) {
+  std::vector<ScoredSegment> out;
+  for (std::size_t k = 0; k < segments.size(); ++k) {
+    ScoredSegment seg;
+    seg.s_begin_m = segments[k].s_begin_m;
+    seg.s_end_m = segments[k].s_end_m;
+    seg.covisible = static_cast<int>(segments[k].covisible.size());
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t j = 0; j < graph.scores.size(); ++j) {
+      if (graph.layer_segment[j] == static_cast<int>(k)) {
+        sum += graph.scores[j];
+        ++n;
+      }
+    }
+    if (n == 0 && !graph.scores.empty()) {
+      const double mid = 0.5 * (seg.s_begin_m + seg.s_end_m);
+      std::size_t nearest = 0;
+      for (std::size_t j = 1; j < graph.layer_s.size(); ++j) {
+        if (std::abs(graph.layer_s[j] - mid) < std::abs(graph.layer_s[nearest] - mid)) nearest = j;
+      }
+      sum = graph.scores[nearest];
+      n = 1;
+    }
+    seg.c_p = n > 0 ? sum / n : std::numeric_limits<double>::quiet_NaN();
+    out.push_back(seg);
+  }
+  return out;
+}
+
+}  // namespace
+
+void SelectionConfig::validate() const {
+  require(std::isfinite(c_p_threshold), "c_p_threshold", c_p_threshold, "must be finite");
+  require(distance_weight >= 0.0, "selection.distance_weight", distance_weight, "must be >= 0");
+  require(perception_weight >= 0.0, "selection.perception_weight", perception_weight, "must be >= 0");
+}
+
+void PerceptionPlannerConfig::validate() const {
+  require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
+  require(slice_half_height_m >= 0.0, "slice_half_height_m", slice_half_height_m, "must be >= 0");
+  require(threads >= 0, "threads", threads, "must be >= 0 (0: one per core)");
+  topo.validate();
+  visibility.validate();
+  information.validate();
+  segments.validate();
+  graph.validate();
+  selection.validate();
+}
+
+double selectionCost(double length_m, double shortest_m, double c_p_min, const SelectionConfig& config) {
+  const double extra = shortest_m > 0.0 ? length_m / shortest_m - 1.0 : 0.0;
+  const double f = 1.0 / (1.0 + std::exp(c_p_min - config.c_p_threshold));
+  return config.distance_weight * extra + config.perception_weight * f;
+}
+
+PerceptionPlanner::PerceptionPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config)
+    : voxels_(voxels), config_(config) {
+  config_.topo.robot_radius_m = config_.robot_radius_m;
+  config_.graph.robot_radius_m = config_.robot_radius_m;
+  config_.validate();
+}
+
+PerceptionPlanReport PerceptionPlanner::solve(const Pose4& start, const Pose4& goal, PlannerKind kind,
+                                              std::uint64_t seed) const {
+  PerceptionPlanReport report;
+  const double z = start.p_WB.z();
+  report.flight_height_m = z;
+  const OccupancyGrid2D grid = voxels_.slice(z - config_.slice_half_height_m, z + config_.slice_half_height_m);
+  const TopologicalPlanner topo(grid, config_.topo);
+  report.topo = topo.solve(start.p_WB.head<2>(), goal.p_WB.head<2>());
+  Plan& plan = report.plan;
+  plan.status = report.topo.status;
+  if (report.topo.status != PlanStatus::kSolved) return report;
+
+  const std::size_t n = report.topo.classes.size();
+  plan.candidates.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    plan.candidates[i].h_signature = report.topo.classes[i].h_signature;
+    plan.candidates[i].length_m = report.topo.classes[i].length_m;
+  }
+  if (kind == PlannerKind::kAgnostic) {
+    for (std::size_t i = 0; i < n; ++i) {
+      plan.candidates[i].path = headingPath(lift(report.topo.classes[i].path, z), start.yaw_rad);
+    }
+    plan.chosen = report.topo.chosen;
+    plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
+    return report;
+  }
+
+  report.details.resize(n);
+  auto evaluate = [&](std::size_t i) {
+    const std::vector<Eigen::Vector3d> path = lift(report.topo.classes[i].path, z);
+    ClassDetail& detail = report.details[i];
+    detail.segments = extractSegments(
+        path, config_.segments, [&](const Eigen::Vector3d& p) { return voxels_.visibleFrom(p, config_.visibility); },
+        &detail.visibility_queries);
+    detail.graph = searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information,
+                                   config_.graph, config_.keep_start_yaw ? start.yaw_rad : std::nan(""),
+                                   classSeed(seed, i));
+    CandidatePath& c = plan.candidates[i];
+    c.feasible = detail.graph.found;
+    c.segments = scoreSegments(detail.segments, detail.graph);
+    if (!c.feasible) return;
+    c.path = detail.graph.path;
+    c.length_m = detail.graph.c_d;
+    c.c_p = detail.graph.c_p;
+    c.c_p_min = std::numeric_limits<double>::infinity();
+    for (const ScoredSegment& s : c.segments) c.c_p_min = std::min(c.c_p_min, s.c_p);
+  };
+  tbb::task_arena arena(config_.threads > 0 ? config_.threads : tbb::task_arena::automatic);
+  arena.execute([&] { tbb::parallel_for(std::size_t{0}, n, evaluate); });
+
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const CandidatePath& c : plan.candidates) {
+    if (c.feasible) shortest = std::min(shortest, c.length_m);
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    CandidatePath& c = plan.candidates[i];
+    if (!c.feasible) continue;
+    c.cost = selectionCost(c.length_m, shortest, c.c_p_min, config_.selection);
+    if (plan.chosen < 0 || c.cost < plan.candidates[static_cast<std::size_t>(plan.chosen)].cost) {
+      plan.chosen = static_cast<int>(i);
+    }
+  }
+  if (plan.chosen < 0) {
+    plan.status = PlanStatus::kNoPath;
+    return report;
+  }
+  plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
+  return report;
+}
+
+}  // namespace tgnav::planner

@@ -1,0 +1,218 @@
+#include "planner/pose_graph.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "planner/check.h"
+
+namespace tgnav::planner {
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Angle in [-pi, pi] for arguments within a few turns (cheaper than std::remainder).
+double wrapAngle(double a) {
+  while (a > M_PI) a -= 2.0 * M_PI;
+  while (a < -M_PI) a += 2.0 * M_PI;
+  return a;
+}
+
+// Unit vectors spanning the plane perpendicular to `tangent`.
+void perpendicularBasis(const Eigen::Vector3d& tangent, Eigen::Vector3d* e1, Eigen::Vector3d* e2) {
+  const Eigen::Vector3d t = tangent.normalized();
+  const Eigen::Vector3d up = std::abs(t.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  *e1 = up.cross(t).normalized();  // horizontal, to the left of the path
+  *e2 = t.cross(*e1);              // "up" within the plane
+}
+}  // namespace
+
+void PoseGraphConfig::validate() const {
+  require(nominal_speed_mps > 0.0, "nominal_speed_mps", nominal_speed_mps, "must be > 0");
+  require(time_step_s > 0.0, "time_step_s", time_step_s, "must be > 0");
+  require(position_samples >= 1, "position_samples", position_samples, "must be >= 1");
+  require(sample_radius_m >= 0.0, "sample_radius_m", sample_radius_m, "must be >= 0");
+  require(yaw_samples >= 1, "yaw_samples", yaw_samples, "must be >= 1");
+  require(yaw_rate_limit_rad_s >= 0.0, "yaw_rate_limit_rad_s", yaw_rate_limit_rad_s, "must be >= 0");
+  require(yaw_samples == 1 || 2.0 * M_PI / yaw_samples <= yaw_rate_limit_rad_s * time_step_s + 1e-9, "yaw_samples",
+          yaw_samples, "the yaw interval 2 pi / yaw_samples must not exceed yaw_rate_limit_rad_s * time_step_s, or the yaw could never change");
+  require(distance_weight >= 0.0, "distance_weight", distance_weight, "must be >= 0");
+  require(perception_weight >= 0.0, "perception_weight", perception_weight, "must be >= 0");
+  require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
+}
+
+DagPath shortestLayeredPath(const LayeredDag& dag) {
+  DagPath result;
+  const std::size_t layers = dag.node_cost.size();
+  if (layers == 0) return result;
+  std::vector<std::vector<double>> best(layers);
+  std::vector<std::vector<int>> parent(layers);
+  best[0] = dag.node_cost[0];
+  parent[0].assign(best[0].size(), -1);
+  for (std::size_t j = 0; j + 1 < layers; ++j) {
+    best[j + 1].assign(dag.node_cost[j + 1].size(), kInf);
+    parent[j + 1].assign(dag.node_cost[j + 1].size(), -1);
+    for (const LayeredDag::Edge& e : dag.edges[j]) {
+      const double c = best[j][static_cast<std::size_t>(e.from)] + e.cost;
+      const std::size_t to = static_cast<std::size_t>(e.to);
+      if (c < best[j + 1][to] || (c == best[j + 1][to] && c < kInf && e.from < parent[j + 1][to])) {
+        best[j + 1][to] = c;
+        parent[j + 1][to] = e.from;
+      }
+    }
+    for (std::size_t n = 0; n < best[j + 1].size(); ++n) best[j + 1][n] += dag.node_cost[j + 1][n];
+  }
+  int end = -1;
+  for (std::size_t n = 0; n < best.back().size(); ++n) {
+    if (best.back()[n] < kInf && (end < 0 || best.back()[n] < best.back()[static_cast<std::size_t>(end)])) {
+      end = static_cast<int>(n);
+    }
+  }
+  if (end < 0) return result;
+  result.found = true;
+  result.cost = best.back()[static_cast<std::size_t>(end)];
+  result.nodes.assign(layers, -1);
+  for (std::size_t j = layers; j-- > 0;) {
+    result.nodes[j] = end;
+    end = parent[j][static_cast<std::size_t>(end)];
+  }
+  return result;
+}
+
+PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const std::vector<PathSegment>& segments,
+                                const VoxelMap& voxels, const VisibilityConfig& visibility,
+                                const InformationConfig& information, const PoseGraphConfig& config,
+                                double start_yaw_rad, std::uint64_t seed) {
+  PoseGraphResult result;
+  const double length = polylineLength3(path);
+  const double spacing_max = config.nominal_speed_mps * config.time_step_s;
+  const int intervals = std::max(1, static_cast<int>(std::ceil(length / spacing_max - 1e-9)));
+  const int layers = intervals + 1;
+  const double spacing = length / intervals;
+  const int yaws = config.yaw_samples;
+  const double yaw_step = 2.0 * M_PI / yaws;
+  const double yaw0 = std::isnan(start_yaw_rad) ? 0.0 : start_yaw_rad;
+  const int max_yaw_steps =
+      yaws == 1 ? 0
+                : std::min(yaws / 2, static_cast<int>(std::floor(config.yaw_rate_limit_rad_s * spacing /
+                                                                     config.nominal_speed_mps / yaw_step + 1e-9)));
+
+  // Landmarks of each segment's co-visible set, grouped by voxel once.
+  std::vector<std::vector<WeightedPoint>> segment_points;
+  segment_points.reserve(segments.size());
+  for (const PathSegment& seg : segments) segment_points.push_back(aggregateByVoxel(voxels, seg.covisible));
+
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<std::vector<Eigen::Vector3d>> positions(static_cast<std::size_t>(layers));
+  LayeredDag dag;
+  dag.node_cost.resize(static_cast<std::size_t>(layers));
+  dag.edges.resize(static_cast<std::size_t>(layers - 1));
+  std::vector<std::vector<double>> scores(static_cast<std::size_t>(layers));
+  result.layer_s.resize(static_cast<std::size_t>(layers));
+  result.layer_segment.resize(static_cast<std::size_t>(layers));
+  const int half_window = static_cast<int>(std::ceil(0.5 * visibility.hfov_rad / yaw_step)) + 1;
+  std::vector<double> yaw_of(static_cast<std::size_t>(yaws));
+  for (int k = 0; k < yaws; ++k) yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
+
+  for (int j = 0; j < layers; ++j) {
+    const double s = j == layers - 1 ? length : spacing * j;
+    result.layer_s[static_cast<std::size_t>(j)] = s;
+    const Eigen::Vector3d centre = pointAt(path, s);
+    std::vector<Eigen::Vector3d> candidates{centre};
+    if (j > 0 && j < layers - 1) {
+      Eigen::Vector3d e1, e2;
+      const Eigen::Vector3d tangent = pointAt(path, s + 0.05) - pointAt(path, s - 0.05);
+      perpendicularBasis(tangent.norm() > 1e-9 ? tangent : Eigen::Vector3d::UnitX(), &e1, &e2);
+      for (int k = 1; k < config.position_samples; ++k) {
+        const double r = config.sample_radius_m * std::sqrt(unit(rng));
+        const double a = 2.0 * M_PI * unit(rng);
+        candidates.push_back(centre + r * (std::cos(a) * e1 + std::sin(a) * e2));
+      }
+    }
+    int seg = 0;
+    while (seg + 1 < static_cast<int>(segments.size()) && segments[static_cast<std::size_t>(seg)].s_end_m < s) ++seg;
+    result.layer_segment[static_cast<std::size_t>(j)] = seg;
+    const std::vector<WeightedPoint>& points = segment_points.empty() ? std::vector<WeightedPoint>{}
+                                                                      : segment_points[static_cast<std::size_t>(seg)];
+    auto& layer_positions = positions[static_cast<std::size_t>(j)];
+    auto& layer_cost = dag.node_cost[static_cast<std::size_t>(j)];
+    auto& layer_scores = scores[static_cast<std::size_t>(j)];
+    for (const Eigen::Vector3d& p : candidates) {
+      if (voxels.clearance(p) < config.robot_radius_m) continue;
+      layer_positions.push_back(p);
+      // Information per yaw: each landmark adds to the yaws whose horizontal FoV holds it.
+      std::vector<Matrix6d> info(static_cast<std::size_t>(yaws), Matrix6d::Zero());
+      for (const WeightedPoint& pt : points) {
+        const Eigen::Vector3d d = pt.p_W - p;
+        const double range = d.norm();
+        if (range < visibility.min_range_m || range > visibility.max_range_m) continue;
+        if (std::atan2(std::abs(d.z()), d.head<2>().norm()) > 0.5 * visibility.vfov_rad) continue;
+        const double azimuth = std::atan2(d.y(), d.x());
+        Matrix6d contribution = Matrix6d::Zero();
+        addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
+        // Only yaws near the landmark's azimuth can hold it (all of them when the FoV is wide
+        // compared to the yaw grid).
+        const bool all = 2 * half_window + 1 >= yaws;
+        const int nearest = all ? 0 : static_cast<int>(std::lround((azimuth - yaw0) / yaw_step));
+        const int first = all ? 0 : nearest - half_window;
+        const int last = all ? yaws - 1 : nearest + half_window;
+        for (int k = first; k <= last; ++k) {
+          const int idx = ((k % yaws) + yaws) % yaws;
+          if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
+            info[static_cast<std::size_t>(idx)] += contribution;
+          }
+        }
+      }
+      for (int k = 0; k < yaws; ++k) {
+        const double score = logDetInformation(info[static_cast<std::size_t>(k)], information.epsilon);
+        const bool allowed = !(j == 0 && !std::isnan(start_yaw_rad) && k != 0);
+        layer_scores.push_back(score);
+        layer_cost.push_back(allowed ? -config.perception_weight * score / layers : kInf);
+      }
+    }
+    if (layer_positions.empty() && result.blocked_layer < 0) result.blocked_layer = j;
+  }
+
+  for (int j = 0; j + 1 < layers; ++j) {
+    const auto& from = positions[static_cast<std::size_t>(j)];
+    const auto& to = positions[static_cast<std::size_t>(j + 1)];
+    auto& edges = dag.edges[static_cast<std::size_t>(j)];
+    for (std::size_t a = 0; a < from.size(); ++a) {
+      for (std::size_t b = 0; b < to.size(); ++b) {
+        if (!voxels.segmentClear(from[a], to[b], config.robot_radius_m)) continue;
+        const double cost = config.distance_weight * (to[b] - from[a]).norm();
+        for (int k = 0; k < yaws; ++k) {
+          for (int d = -max_yaw_steps; d <= max_yaw_steps; ++d) {
+            if (2 * d == yaws) continue;  // the same yaw as d = -yaws / 2
+            const int kb = ((k + d) % yaws + yaws) % yaws;
+            edges.push_back({static_cast<int>(a) * yaws + k, static_cast<int>(b) * yaws + kb, cost});
+          }
+        }
+      }
+    }
+    result.edges += static_cast<int>(edges.size());
+  }
+  for (const auto& layer : dag.node_cost) result.nodes += static_cast<int>(layer.size());
+
+  const DagPath best = shortestLayeredPath(dag);
+  if (!best.found) return result;
+  result.found = true;
+  result.cost = best.cost;
+  for (int j = 0; j < layers; ++j) {
+    const int node = best.nodes[static_cast<std::size_t>(j)];
+    const int k = node % yaws;
+    Pose4 pose;
+    pose.p_WB = positions[static_cast<std::size_t>(j)][static_cast<std::size_t>(node / yaws)];
+    pose.yaw_rad = yaw_of[static_cast<std::size_t>(k)];
+    if (!result.path.empty()) result.c_d += (pose.p_WB - result.path.back().p_WB).norm();
+    result.path.push_back(pose);
+    result.scores.push_back(scores[static_cast<std::size_t>(j)][static_cast<std::size_t>(node)]);
+  }
+  double sum = 0.0;
+  for (double s : result.scores) sum += s;
+  result.c_p = sum / layers;
+  return result;
+}
+
+}  // namespace tgnav::planner

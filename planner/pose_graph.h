@@ -1,0 +1,83 @@
+#pragma once
+// 4-DoF pose graph inside one homology class and its exact search (paper Sec. V-D).
+//
+// The class's path is cut into N-1 equal intervals no longer than v_nom * Ts; each cut is a
+// layer. A layer's positions are the path point itself plus random points (seeded) within
+// R_sample of it on the plane through it perpendicular to the path; each position is combined
+// with yaw_samples yaws at equal intervals (the start's yaw among them). The first layer is the
+// start, the last the goal. Edges join consecutive layers only, where the straight move keeps
+// the robot radius from every 3D obstacle of the map and the yaw changes by at most
+// yaw_rate_limit * (interval / v_nom). A node's information I(n) sums the bearing Fisher
+// information (eqs. 5-6) of the landmarks of its segment's co-visible set that are inside its
+// field of view. The path minimises (eq. 7)
+//     lambda_d * c_d(P) - lambda_p * c_p(P),   c_p(P) = (1/N) sum_i log det I(n_i)   (eq. 8)
+// which splits into node and edge costs on a layered DAG: dynamic programming over the layers
+// in order finds the exact minimum in O(nodes + edges).
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "planner/covisibility.h"
+#include "planner/perception.h"
+#include "planner/pose4.h"
+#include "planner/voxel_map.h"
+
+namespace tgnav::planner {
+
+struct PoseGraphConfig {
+  double nominal_speed_mps = 0.4;     // v_nom (Table I)
+  double time_step_s = 1.0;           // Ts
+  int position_samples = 10;          // per layer, the path point included
+  double sample_radius_m = 0.4;       // R_sample
+  int yaw_samples = 24;               // equal intervals over 2 pi (the paper does not give a count)
+  double yaw_rate_limit_rad_s = 0.3;  // psi_dot_lim
+  double distance_weight = 0.1;       // lambda_d
+  double perception_weight = 1.0;     // lambda_p
+  double robot_radius_m = 0.3;        // clearance of every node and edge
+
+  void validate() const;
+};
+
+// A DAG in layers: every edge goes from layer j to layer j + 1. A path starts anywhere in the
+// first layer and ends anywhere in the last; its cost is the sum of its node and edge costs.
+struct LayeredDag {
+  struct Edge {
+    int from = 0;  // node in layer j
+    int to = 0;    // node in layer j + 1
+    double cost = 0.0;
+  };
+  std::vector<std::vector<double>> node_cost;  // +inf: node not usable
+  std::vector<std::vector<Edge>> edges;        // edges[j]: layer j -> j + 1
+};
+
+struct DagPath {
+  bool found = false;
+  double cost = 0.0;
+  std::vector<int> nodes;  // one per layer
+};
+
+// Exact minimum-cost path by dynamic programming in layer order; ties go to the lower index.
+DagPath shortestLayeredPath(const LayeredDag& dag);
+
+struct PoseGraphResult {
+  bool found = false;
+  std::vector<Pose4> path;       // one pose per layer
+  std::vector<double> layer_s;   // arclength of each layer along the reference path
+  std::vector<double> scores;    // log det I of each chosen node
+  std::vector<int> layer_segment;  // segment index of each layer
+  double c_d = 0.0;              // length of `path`
+  double c_p = 0.0;              // eq. 8
+  double cost = 0.0;             // eq. 7
+  int nodes = 0;
+  int edges = 0;
+  int blocked_layer = -1;        // when not found: first layer without a collision-free node, if any
+};
+
+// `path` is the class's reference path (3D, start to goal), `segments` its segments (in order,
+// covering it). start_yaw_rad: the start node's yaw, or NaN to leave it free.
+PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const std::vector<PathSegment>& segments,
+                                const VoxelMap& voxels, const VisibilityConfig& visibility,
+                                const InformationConfig& information, const PoseGraphConfig& config,
+                                double start_yaw_rad, std::uint64_t seed);
+
+}  // namespace tgnav::planner

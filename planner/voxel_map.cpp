@@ -1,0 +1,247 @@
+#include "planner/voxel_map.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "planner/edt.h"
+
+namespace tgnav::planner {
+
+namespace {
+constexpr double kFar = 1e20;
+}
+
+VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W)
+    : res_(map.resolution()) {
+  const Eigen::Vector3d lo = (min_W / res_).array().floor();
+  const Eigen::Vector3d hi = (max_W / res_).array().ceil();
+  origin_ = lo * res_;
+  size_ = (hi - lo).cast<int>().cwiseMax(1);
+  state_.assign(static_cast<std::size_t>(size_.prod()), VoxelState::kUnknown);
+
+  const octomap::OcTree& tree = map.occupancy();
+  const octomap::point3d bmin(static_cast<float>(origin_.x()), static_cast<float>(origin_.y()),
+                              static_cast<float>(origin_.z()));
+  const Eigen::Vector3d top = origin_ + size_.cast<double>() * res_;
+  const octomap::point3d bmax(static_cast<float>(top.x()), static_cast<float>(top.y()), static_cast<float>(top.z()));
+  for (auto it = tree.begin_leafs_bbx(bmin, bmax), end = tree.end_leafs_bbx(); it != end; ++it) {
+    const VoxelState s = tree.isNodeOccupied(*it) ? VoxelState::kOccupied : VoxelState::kFree;
+    const double half = 0.5 * it.getSize();
+    const Eigen::Vector3d c(it.getX(), it.getY(), it.getZ());
+    // Leaves may be merged cubes of many voxels: fill every voxel they cover inside the box.
+    const Eigen::Vector3i a = cellOf(c - Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMax(0);
+    const Eigen::Vector3i b = cellOf(c + Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMin(size_ - Eigen::Vector3i::Ones());
+    for (int z = a.z(); z <= b.z(); ++z) {
+      for (int y = a.y(); y <= b.y(); ++y) {
+        for (int x = a.x(); x <= b.x(); ++x) state_[static_cast<std::size_t>(flat(x, y, z))] = s;
+      }
+    }
+  }
+
+  std::map<int, std::vector<int>> by_voxel;
+  for (int id = 0; id < static_cast<int>(map.landmarks().size()); ++id) {
+    const Eigen::Vector3i c = cellOf(map.landmarkVoxel(id));
+    if (inside(c)) by_voxel[flat(c.x(), c.y(), c.z())].push_back(id);
+  }
+  landmark_slot_.assign(map.landmarks().size(), -1);
+  for (auto& [index, ids] : by_voxel) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int id : ids) {
+      sum += map.landmarks()[static_cast<std::size_t>(id)].p_W;
+      landmark_slot_[static_cast<std::size_t>(id)] = static_cast<int>(landmark_voxels_.size());
+    }
+    const Eigen::Vector3d mean = sum / static_cast<double>(ids.size());
+    landmark_voxels_.push_back({index, centreOf(index), mean, std::move(ids)});
+  }
+  computeDistanceField();
+}
+
+Eigen::Vector3i VoxelMap::cellOf(const Eigen::Vector3d& p_W) const {
+  return ((p_W - origin_) / res_).array().floor().cast<int>();
+}
+
+Eigen::Vector3d VoxelMap::centreOf(int index) const {
+  const int x = index % size_.x();
+  const int y = (index / size_.x()) % size_.y();
+  const int z = index / (size_.x() * size_.y());
+  return origin_ + res_ * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5);
+}
+
+VoxelState VoxelMap::state(const Eigen::Vector3d& p_W) const {
+  const Eigen::Vector3i c = cellOf(p_W);
+  return inside(c) ? state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] : VoxelState::kUnknown;
+}
+
+bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {
+  // Amanatides & Woo voxel traversal from p to the target voxel's centre.
+  const Eigen::Vector3d target = centreOf(index);
+  const Eigen::Vector3d start = (p_W - origin_) / res_;
+  const Eigen::Vector3d dir = (target - p_W) / res_;
+  Eigen::Vector3i c = start.array().floor().cast<int>();
+  const Eigen::Vector3i goal = ((target - origin_) / res_).array().floor().cast<int>();
+  Eigen::Vector3i step;
+  Eigen::Vector3d t_max;
+  Eigen::Vector3d t_delta;
+  for (int k = 0; k < 3; ++k) {
+    if (dir[k] > 0.0) {
+      step[k] = 1;
+      t_max[k] = (c[k] + 1 - start[k]) / dir[k];
+      t_delta[k] = 1.0 / dir[k];
+    } else if (dir[k] < 0.0) {
+      step[k] = -1;
+      t_max[k] = (c[k] - start[k]) / dir[k];
+      t_delta[k] = -1.0 / dir[k];
+    } else {
+      step[k] = 0;
+      t_max[k] = kFar;
+      t_delta[k] = kFar;
+    }
+  }
+  if (!inside(c)) return false;
+  // Both ends are inside the (convex) box, so every voxel between them is: walk flat indices.
+  const int stride[3] = {step[0], step[1] * size_.x(), step[2] * size_.x() * size_.y()};
+  int idx = flat(c.x(), c.y(), c.z());
+  const int remaining = (goal - c).cwiseAbs().sum();
+  for (int n = 0; n <= remaining; ++n) {
+    if (idx == index) return true;
+    if (state_[static_cast<std::size_t>(idx)] == VoxelState::kOccupied) return false;
+    int k = 0;
+    if (t_max[1] < t_max[k]) k = 1;
+    if (t_max[2] < t_max[k]) k = 2;
+    idx += stride[k];
+    t_max[k] += t_delta[k];
+    if (idx < 0 || idx >= static_cast<int>(state_.size())) return false;
+  }
+  return false;  // numerical miss of the target voxel: treat as not seen
+}
+
+std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
+  std::vector<int> visible;
+  const double tan_half_vfov = std::tan(0.5 * config.vfov_rad);
+  const double min2 = config.min_range_m * config.min_range_m;
+  const double max2 = config.max_range_m * config.max_range_m;
+  for (const LandmarkVoxel& v : landmark_voxels_) {
+    const Eigen::Vector3d d = v.centre_W - p_W;
+    const double r2 = d.squaredNorm();
+    if (r2 < min2 || r2 > max2) continue;
+    if (std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
+    if (!lineOfSight(p_W, v.index)) continue;
+    visible.insert(visible.end(), v.ids.begin(), v.ids.end());
+  }
+  std::sort(visible.begin(), visible.end());
+  return visible;
+}
+
+void VoxelMap::computeDistanceField() {
+  // Padded by one obstacle voxel on every side: outside the box counts as an obstacle.
+  const int nx = size_.x() + 2;
+  const int ny = size_.y() + 2;
+  const int nz = size_.z() + 2;
+  const std::size_t n = static_cast<std::size_t>(nx) * ny * nz;
+  auto pidx = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * ny + y) * nx + x; };
+  std::vector<double> f(n, kFar);
+  std::vector<int> site(n, -1);
+  for (int z = 0; z < nz; ++z) {
+    for (int y = 0; y < ny; ++y) {
+      for (int x = 0; x < nx; ++x) {
+        const bool pad = x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1;
+        const bool blocked = pad || state_[static_cast<std::size_t>(flat(x - 1, y - 1, z - 1))] != VoxelState::kFree;
+        if (blocked) {
+          f[pidx(x, y, z)] = 0.0;
+          site[pidx(x, y, z)] = static_cast<int>(pidx(x, y, z));
+        }
+      }
+    }
+  }
+  // One envelope pass per axis; the site follows the minimising sample.
+  EnvelopeScratch scratch;
+  const int longest = std::max({nx, ny, nz});
+  std::vector<double> line(longest), out(longest);
+  std::vector<int> line_site(longest), arg(longest);
+  auto pass = [&](int len, int lines, auto&& at) {
+    for (int l = 0; l < lines; ++l) {
+      for (int i = 0; i < len; ++i) {
+        line[i] = f[at(l, i)];
+        line_site[i] = site[at(l, i)];
+      }
+      lowerEnvelope(line.data(), len, out.data(), arg.data(), &scratch);
+      for (int i = 0; i < len; ++i) {
+        f[at(l, i)] = out[i];
+        site[at(l, i)] = line_site[arg[i]];
+      }
+    }
+  };
+  pass(nx, ny * nz, [&](int l, int i) { return static_cast<std::size_t>(l) * nx + i; });
+  pass(ny, nx * nz, [&](int l, int i) { return pidx(l % nx, i, l / nx); });
+  pass(nz, nx * ny, [&](int l, int i) { return pidx(l % nx, l / nx, i); });
+  dist2_.assign(f.begin(), f.end());
+  site_ = std::move(site);
+}
+
+double VoxelMap::centreDistance(const Eigen::Vector3i& c) const {
+  const int nx = size_.x() + 2;
+  const int ny = size_.y() + 2;
+  const std::size_t i = (static_cast<std::size_t>(c.z() + 1) * ny + c.y() + 1) * nx + c.x() + 1;
+  return std::sqrt(static_cast<double>(dist2_[i])) * res_;
+}
+
+double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
+  const Eigen::Vector3i c = cellOf(p_W);
+  if (!inside(c) || state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] != VoxelState::kFree) return 0.0;
+  // The nearest obstacle voxel of p is the nearest one of its own voxel or of a neighbour (the
+  // feature transform is exact at centres); measure to that voxel's cube exactly.
+  const int nx = size_.x() + 2;
+  const int ny = size_.y() + 2;
+  const double half = 0.5 * res_;
+  double best = std::numeric_limits<double>::infinity();
+  for (int dz = -1; dz <= 1; ++dz) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Eigen::Vector3i q = c + Eigen::Vector3i(dx, dy, dz) + Eigen::Vector3i::Ones();  // padded
+        const int s = site_[(static_cast<std::size_t>(q.z()) * ny + q.y()) * nx + q.x()];
+        if (s < 0) continue;
+        const Eigen::Vector3d centre =
+            origin_ + res_ * Eigen::Vector3d(s % nx - 0.5, (s / nx) % ny - 0.5, s / (nx * ny) - 0.5);
+        const Eigen::Vector3d d = ((p_W - centre).cwiseAbs().array() - half).cwiseMax(0.0);
+        best = std::min(best, d.norm());
+      }
+    }
+  }
+  return best;
+}
+
+bool VoxelMap::segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m) const {
+  const double len = (b - a).norm();
+  const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * res_))));
+  const double need = clearance_m + 0.5 * len / steps;
+  // A point is at most 0.87 voxels from its voxel's centre and an obstacle voxel's cube reaches
+  // 0.87 voxels from its own: the centre distance less 1.74 voxels bounds the clearance.
+  const double slack = 1.7321 * res_;
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(i) / steps);
+    const Eigen::Vector3i c = cellOf(p);
+    if (inside(c) && centreDistance(c) - slack >= need) continue;
+    if (clearance(p) < need) return false;
+  }
+  return true;
+}
+
+OccupancyGrid2D VoxelMap::slice(double z_lo, double z_hi) const {
+  OccupancyGrid2D grid(size_.x(), size_.y(), res_, origin_.head<2>());
+  const int z0 = std::max(0, cellOf(Eigen::Vector3d(origin_.x(), origin_.y(), z_lo)).z());
+  const int z1 = std::min(size_.z() - 1, cellOf(Eigen::Vector3d(origin_.x(), origin_.y(), z_hi)).z());
+  for (int y = 0; y < size_.y(); ++y) {
+    for (int x = 0; x < size_.x(); ++x) {
+      bool blocked = z0 > z1;
+      for (int z = z0; z <= z1 && !blocked; ++z) {
+        blocked = state_[static_cast<std::size_t>(flat(x, y, z))] != VoxelState::kFree;
+      }
+      grid.set(x, y, blocked);
+    }
+  }
+  return grid;
+}
+
+}  // namespace tgnav::planner

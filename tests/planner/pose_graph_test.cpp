@@ -1,0 +1,312 @@
+// 4-DoF pose graph (paper Sec. V-D): the layered-DAG dynamic programme against brute force,
+// and the pose graph search on a synthetic corridor (determinism, clearance, yaw-rate limit,
+// layer spacing, end points, perception pulling the yaw towards the textured wall, the straight
+// reference line without perception), plus config validation.
+#include "planner/pose_graph.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "tests/planner/synthetic_world.h"
+
+namespace tgnav::planner {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// ---------------------------------------------------------------------------------------------
+// Layered DAG: exact DP vs. enumeration of every node sequence.
+
+struct Brute {
+  bool found = false;
+  double cost = kInf;
+};
+
+// Cost of a node sequence (node0 + e0 + node1 + e1 + ... in layer order); +inf if not a path.
+double sequenceCost(const LayeredDag& dag, const std::vector<int>& nodes) {
+  double c = dag.node_cost[0][static_cast<std::size_t>(nodes[0])];
+  for (std::size_t j = 0; j + 1 < nodes.size(); ++j) {
+    double best_edge = kInf;
+    for (const auto& e : dag.edges[j]) {
+      if (e.from == nodes[j] && e.to == nodes[j + 1]) best_edge = std::min(best_edge, e.cost);
+    }
+    c += best_edge;
+    c += dag.node_cost[j + 1][static_cast<std::size_t>(nodes[j + 1])];
+  }
+  return c;
+}
+
+Brute bruteForce(const LayeredDag& dag) {
+  Brute b;
+  const std::size_t layers = dag.node_cost.size();
+  std::vector<int> nodes(layers, 0);
+  while (true) {
+    const double c = sequenceCost(dag, nodes);
+    if (c < b.cost) {
+      b.cost = c;
+      b.found = true;
+    }
+    std::size_t j = 0;
+    while (j < layers && ++nodes[j] == static_cast<int>(dag.node_cost[j].size())) nodes[j++] = 0;
+    if (j == layers) break;
+  }
+  return b;
+}
+
+TEST(LayeredDag, DynamicProgrammeEqualsBruteForceOnRandomDags) {
+  std::mt19937_64 rng(21);
+  std::uniform_int_distribution<int> n_layers(2, 5), n_nodes(1, 4);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int with_path = 0;
+  int without_path = 0;
+  for (int g = 0; g < 300; ++g) {
+    LayeredDag dag;
+    const int layers = g < 10 ? 1 + g % 2 : n_layers(rng);  // a few one- and two-layer graphs first
+    const double p_edge = 0.2 + 0.7 * unit(rng);
+    const double p_inf = 0.25 * unit(rng);
+    dag.node_cost.resize(static_cast<std::size_t>(layers));
+    dag.edges.resize(static_cast<std::size_t>(std::max(0, layers - 1)));
+    for (int j = 0; j < layers; ++j) {
+      const int n = n_nodes(rng);
+      for (int k = 0; k < n; ++k) {
+        // Negative costs too: the planner's node costs are -lambda_p log det / N.
+        dag.node_cost[static_cast<std::size_t>(j)].push_back(unit(rng) < p_inf ? kInf : 4.0 * unit(rng) - 2.0);
+      }
+    }
+    for (int j = 0; j + 1 < layers; ++j) {
+      for (int a = 0; a < static_cast<int>(dag.node_cost[static_cast<std::size_t>(j)].size()); ++a) {
+        for (int b = 0; b < static_cast<int>(dag.node_cost[static_cast<std::size_t>(j + 1)].size()); ++b) {
+          if (unit(rng) < p_edge) dag.edges[static_cast<std::size_t>(j)].push_back({a, b, 3.0 * unit(rng)});
+          if (unit(rng) < 0.1) dag.edges[static_cast<std::size_t>(j)].push_back({a, b, 3.0 * unit(rng)});  // parallel
+        }
+      }
+      std::shuffle(dag.edges[static_cast<std::size_t>(j)].begin(), dag.edges[static_cast<std::size_t>(j)].end(), rng);
+    }
+    const Brute expected = bruteForce(dag);
+    const DagPath got = shortestLayeredPath(dag);
+    ASSERT_EQ(got.found, expected.found) << "graph " << g;
+    if (!expected.found) {
+      ++without_path;
+      continue;
+    }
+    ++with_path;
+    EXPECT_NEAR(got.cost, expected.cost, 1e-12) << "graph " << g;
+    ASSERT_EQ(got.nodes.size(), static_cast<std::size_t>(layers)) << "graph " << g;
+    for (int j = 0; j < layers; ++j) {
+      ASSERT_GE(got.nodes[static_cast<std::size_t>(j)], 0);
+      ASSERT_LT(got.nodes[static_cast<std::size_t>(j)], static_cast<int>(dag.node_cost[static_cast<std::size_t>(j)].size()));
+    }
+    // The returned sequence is a path (every step an edge) whose cost is the reported one.
+    EXPECT_NEAR(sequenceCost(dag, got.nodes), got.cost, 1e-12) << "graph " << g;
+  }
+  EXPECT_GT(with_path, 100);
+  EXPECT_GT(without_path, 10);
+  std::cout << "[ figure   ] layered DAGs checked against brute force: " << with_path << " with a path, "
+            << without_path << " without\n";
+}
+
+TEST(LayeredDag, TiesGoToTheLowerIndexAndEmptyGraphsHaveNoPath) {
+  LayeredDag dag;
+  dag.node_cost = {{0.0, 0.0}, {1.0, 1.0, 1.0}, {0.0, 0.0}};
+  dag.edges = {{{1, 2, 0.5}, {0, 2, 0.5}, {1, 1, 0.5}}, {{2, 1, 0.0}, {1, 1, 0.0}, {2, 0, 0.0}, {1, 0, 0.0}}};
+  const DagPath p = shortestLayeredPath(dag);
+  ASSERT_TRUE(p.found);
+  EXPECT_DOUBLE_EQ(p.cost, 1.5);
+  EXPECT_EQ(p.nodes, (std::vector<int>{1, 1, 0}));  // 1 before 2 in layer 1, then 1 before 0 in layer 0
+  EXPECT_FALSE(shortestLayeredPath(LayeredDag{}).found);
+  LayeredDag blocked;
+  blocked.node_cost = {{0.0}, {kInf}};
+  blocked.edges = {{{0, 0, 1.0}}};
+  EXPECT_FALSE(shortestLayeredPath(blocked).found);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pose graph on a corridor 8 m long along x, 1 m wide (y in [1, 2]), 2.5 m high: walls are
+// solids 0.3 m thick; the flight line is y = 1.5, z = 1. Robot radius 0.3 and R_sample 0.4
+// leave some samples in collision, so the clearance checks bite.
+
+constexpr double kZ = 1.0;
+
+struct Corridor {
+  VoxelMap voxels;
+  std::vector<Eigen::Vector3d> path;
+};
+
+// side: +1 textures the +y wall (its face towards the corridor), -1 the -y wall, 0 none.
+std::unique_ptr<Corridor> corridor(int side) {
+  testing::SyntheticWorld w;
+  w.min_W = {0.0, 0.7, 0.0};
+  w.max_W = {8.0, 2.3, 2.5};
+  const Eigen::AlignedBox3d lo(Eigen::Vector3d(0.0, 0.7, 0.0), Eigen::Vector3d(8.0, 1.0, 2.5));
+  const Eigen::AlignedBox3d hi(Eigen::Vector3d(0.0, 2.0, 0.0), Eigen::Vector3d(8.0, 2.3, 2.5));
+  w.solids = {lo, hi};
+  if (side > 0) w.texture(hi, Eigen::Vector3d(0, -1, 0), 0.1);
+  if (side < 0) w.texture(lo, Eigen::Vector3d(0, 1, 0), 0.1);
+  // Reference keyframes 0.5 m in front of the face (1 m would put them inside the other wall,
+  // and embedLandmarks() would drop them).
+  for (Landmark& lm : w.landmarks) lm.ref_kf_p_W = lm.p_W + 0.5 * (lm.ref_kf_p_W - lm.p_W);
+  const FeatureMap map = w.build();
+  EXPECT_EQ(map.landmarks().size(), side == 0 ? 0u : 2000u);
+  auto c = std::unique_ptr<Corridor>(new Corridor{VoxelMap(map, w.min_W, w.max_W), {}});
+  c->path = {{0.5, 1.5, kZ}, {4.0, 1.5, kZ}, {7.5, 1.5, kZ}};
+  return c;
+}
+
+const Corridor& texturedCorridor(int side) {
+  static std::unique_ptr<Corridor> plus = corridor(+1);
+  static std::unique_ptr<Corridor> minus = corridor(-1);
+  return side > 0 ? *plus : *minus;
+}
+
+PoseGraphResult search(const Corridor& c, const PoseGraphConfig& config, std::uint64_t seed,
+                       double start_yaw = std::nan("")) {
+  const VisibilityConfig vis;
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  return searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, config, start_yaw, seed);
+}
+
+double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+void expectFeasible(const Corridor& c, const PoseGraphResult& r, const PoseGraphConfig& config) {
+  ASSERT_TRUE(r.found);
+  const double length = polylineLength3(c.path);
+  const std::size_t n = r.path.size();
+  ASSERT_EQ(r.layer_s.size(), n);
+  ASSERT_EQ(r.scores.size(), n);
+  EXPECT_EQ(static_cast<int>(n), static_cast<int>(std::ceil(length / (config.nominal_speed_mps * config.time_step_s) - 1e-9)) + 1);
+  EXPECT_LT((r.path.front().p_WB - c.path.front()).norm(), 1e-12);
+  EXPECT_LT((r.path.back().p_WB - c.path.back()).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(r.layer_s.front(), 0.0);
+  EXPECT_NEAR(r.layer_s.back(), length, 1e-12);
+  double c_d = 0.0;
+  double score_sum = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    EXPECT_GE(c.voxels.clearance(r.path[j].p_WB), config.robot_radius_m) << "layer " << j;
+    // Each node lies on its layer's plane, within R_sample of the path point.
+    const Eigen::Vector3d centre = pointAt(c.path, r.layer_s[j]);
+    EXPECT_NEAR(r.path[j].p_WB.x(), centre.x(), 1e-9) << "layer " << j;
+    EXPECT_LE((r.path[j].p_WB - centre).norm(), config.sample_radius_m + 1e-9) << "layer " << j;
+    score_sum += r.scores[j];
+    if (j == 0) continue;
+    const double spacing = r.layer_s[j] - r.layer_s[j - 1];
+    EXPECT_GT(spacing, 0.0);
+    EXPECT_LE(spacing, config.nominal_speed_mps * config.time_step_s + 1e-12) << "layer " << j;
+    EXPECT_TRUE(c.voxels.segmentClear(r.path[j - 1].p_WB, r.path[j].p_WB, config.robot_radius_m)) << "layer " << j;
+    EXPECT_LE(std::abs(wrap(r.path[j].yaw_rad - r.path[j - 1].yaw_rad)),
+              config.yaw_rate_limit_rad_s * spacing / config.nominal_speed_mps + 1e-9)
+        << "layer " << j;
+    c_d += (r.path[j].p_WB - r.path[j - 1].p_WB).norm();
+  }
+  EXPECT_NEAR(r.c_d, c_d, 1e-9);
+  EXPECT_NEAR(r.c_p, score_sum / static_cast<double>(n), 1e-9);
+  EXPECT_NEAR(r.cost, config.distance_weight * r.c_d - config.perception_weight * r.c_p, 1e-9);
+}
+
+TEST(PoseGraph, CorridorSearchIsDeterministicFeasibleAndRateLimited) {
+  const Corridor& c = texturedCorridor(+1);
+  const PoseGraphConfig config;
+  const PoseGraphResult a = search(c, config, 7);
+  const PoseGraphResult b = search(c, config, 7);
+  expectFeasible(c, a, config);
+  ASSERT_EQ(a.path.size(), b.path.size());
+  for (std::size_t j = 0; j < a.path.size(); ++j) {
+    EXPECT_EQ(a.path[j].p_WB, b.path[j].p_WB) << "layer " << j;
+    EXPECT_EQ(a.path[j].yaw_rad, b.path[j].yaw_rad) << "layer " << j;
+  }
+  EXPECT_EQ(a.cost, b.cost);
+  EXPECT_EQ(a.nodes, b.nodes);
+  EXPECT_EQ(a.edges, b.edges);
+  // Some samples collide (the corridor leaves 0.2 m of lateral play for 0.4 m of R_sample).
+  const int layers = static_cast<int>(a.path.size());
+  const int all_nodes = (2 + (layers - 2) * config.position_samples) * config.yaw_samples;
+  EXPECT_LT(a.nodes, all_nodes);
+  EXPECT_GT(a.nodes, 2 * config.yaw_samples);
+  // Another seed, other samples, still feasible.
+  expectFeasible(c, search(c, config, 8), config);
+  // A fixed start yaw is kept.
+  const PoseGraphResult fixed = search(c, config, 7, 0.3);
+  expectFeasible(c, fixed, config);
+  EXPECT_NEAR(fixed.path.front().yaw_rad, 0.3, 1e-12);
+  std::cout << "[ figure   ] corridor pose graph: " << layers << " layers, " << a.nodes << " of " << all_nodes
+            << " nodes collision-free, " << a.edges << " edges, c_d " << a.c_d << " m, c_p " << a.c_p << "\n";
+}
+
+TEST(PoseGraph, PerceptionPullsTheYawTowardsTheTexturedWall) {
+  const PoseGraphConfig config;
+  for (int side : {+1, -1}) {
+    const Corridor& c = texturedCorridor(side);
+    const PoseGraphResult r = search(c, config, 3);
+    expectFeasible(c, r, config);
+    double mean_sin = 0.0;
+    int towards = 0;
+    for (const Pose4& p : r.path) {
+      mean_sin += std::sin(p.yaw_rad) / static_cast<double>(r.path.size());
+      towards += side * std::sin(p.yaw_rad) > 0.2;
+    }
+    EXPECT_GT(side * mean_sin, 0.5) << "side " << side;
+    EXPECT_GE(towards, static_cast<int>(0.9 * static_cast<double>(r.path.size()))) << "side " << side;
+    std::cout << "[ figure   ] textured wall on side " << side << ": mean sin(yaw) " << mean_sin << ", " << towards
+              << "/" << r.path.size() << " poses facing it, c_p " << r.c_p << "\n";
+  }
+}
+
+TEST(PoseGraph, WithoutPerceptionThePathIsTheReferenceLine) {
+  const Corridor& c = texturedCorridor(+1);
+  PoseGraphConfig config;
+  config.perception_weight = 0.0;
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    const PoseGraphResult r = search(c, config, seed);
+    expectFeasible(c, r, config);
+    for (std::size_t j = 0; j < r.path.size(); ++j) {
+      EXPECT_LT((r.path[j].p_WB - pointAt(c.path, r.layer_s[j])).norm(), 1e-12) << "seed " << seed << " layer " << j;
+    }
+    EXPECT_NEAR(r.c_d, polylineLength3(c.path), 1e-9);
+  }
+  // With perception, the path leaves the line for a better view (so the check above can fail).
+  const PoseGraphResult p = search(c, PoseGraphConfig{}, 1);
+  double off = 0.0;
+  for (std::size_t j = 0; j < p.path.size(); ++j) off = std::max(off, (p.path[j].p_WB - pointAt(c.path, p.layer_s[j])).norm());
+  std::cout << "[ figure   ] largest departure from the reference line with perception: " << off << " m\n";
+}
+
+void expectRejected(const PoseGraphConfig& config, const std::string& field) {
+  try {
+    config.validate();
+    ADD_FAILURE() << "accepted, expected a complaint about " << field;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  }
+}
+
+TEST(PoseGraph, ConfigValidationNamesTheField) {
+  EXPECT_NO_THROW(PoseGraphConfig{}.validate());
+  PoseGraphConfig c;
+  c.yaw_samples = 4;  // 2 pi / 4 = 1.57 rad > 0.3 rad/s * 1 s
+  expectRejected(c, "yaw_samples");
+  c = PoseGraphConfig{};
+  c.yaw_samples = 20;  // 0.314 > 0.3
+  expectRejected(c, "yaw_samples");
+  c.yaw_samples = 21;  // 0.299 <= 0.3
+  EXPECT_NO_THROW(c.validate());
+  c = PoseGraphConfig{};
+  c.distance_weight = -0.1;
+  expectRejected(c, "distance_weight");
+  c = PoseGraphConfig{};
+  c.perception_weight = -1.0;
+  expectRejected(c, "perception_weight");
+  c = PoseGraphConfig{};
+  c.position_samples = 0;
+  expectRejected(c, "position_samples");
+}
+
+}  // namespace
+}  // namespace tgnav::planner
