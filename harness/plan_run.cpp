@@ -63,8 +63,12 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, Pla
   run.seed = seed;
   const SceneConfig& scene = scenario.scene;
   auto t0 = std::chrono::steady_clock::now();
+  // Collision checks happen within the pose graph's samples around the flight height.
+  const double z = scene.start.p_WB.z();
+  const double reach = scenario.planner.perception.graph.sample_radius_m + scenario.planner.perception.robot_radius_m;
   run.voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                   scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m));
+                                                   scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
+                                                   z - reach - 0.2, z + reach + 0.2);
   run.voxel_map_s = since(t0);
 
   const planner::PerceptionPlanner perception(*run.voxels, scenario.planner.perception);
@@ -82,7 +86,6 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, Pla
     run.report.plan = rrt.solve(scene.start, scene.goal, seed);
     run.solve_s = since(t0);
     // The topological classes only to say which class RRT* ended up in (not timed).
-    const double z = scene.start.p_WB.z();
     const double band = scenario.planner.perception.slice_half_height_m;
     planner::TopoPlannerConfig topo_config = scenario.planner.perception.topo;
     topo_config.robot_radius_m = scenario.planner.perception.robot_radius_m;

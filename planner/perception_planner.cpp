@@ -1,6 +1,8 @@
 #include "planner/perception_planner.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -155,7 +157,15 @@ PerceptionPlanReport PerceptionPlanner::solve(const Pose4& start, const Pose4& g
     for (const ScoredSegment& s : c.segments) c.c_p_min = std::min(c.c_p_min, s.c_p);
   };
   tbb::task_arena arena(config_.threads > 0 ? config_.threads : tbb::task_arena::automatic);
-  arena.execute([&] { tbb::parallel_for(std::size_t{0}, n, evaluate); });
+  // One task per class, longest (slowest) first, so that the threads finish together.
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, n, 1),
+        [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t k = r.begin(); k != r.end(); ++k) evaluate(n - 1 - k);
+        },
+        tbb::simple_partitioner());
+  });
 
   double shortest = std::numeric_limits<double>::infinity();
   for (const CandidatePath& c : plan.candidates) {

@@ -13,7 +13,8 @@ namespace {
 constexpr double kFar = 1e20;
 }
 
-VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W)
+VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W,
+                   double clearance_z_lo_m, double clearance_z_hi_m)
     : res_(map.resolution()) {
   const Eigen::Vector3d lo = (min_W / res_).array().floor();
   const Eigen::Vector3d hi = (max_W / res_).array().ceil();
@@ -55,6 +56,14 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
     const Eigen::Vector3d mean = sum / static_cast<double>(ids.size());
     landmark_voxels_.push_back({index, centreOf(index), mean, std::move(ids)});
   }
+  auto layer = [&](double z) {
+    return static_cast<int>(std::clamp(std::floor((z - origin_.z()) / res_), -1.0, static_cast<double>(size_.z())));
+  };
+  clear_z0_ = std::max(0, layer(clearance_z_lo_m));
+  clear_z1_ = std::min(size_.z() - 1, layer(clearance_z_hi_m));
+  const int reach = static_cast<int>(std::ceil(kClearanceReach_m / res_));
+  edt_z0_ = std::max(0, clear_z0_ - reach);
+  edt_nz_ = std::max(0, std::min(size_.z() - 1, clear_z1_ + reach) - edt_z0_ + 1);
   computeDistanceField();
 }
 
@@ -138,7 +147,7 @@ void VoxelMap::computeDistanceField() {
   // Padded by one obstacle voxel on every side: outside the box counts as an obstacle.
   const int nx = size_.x() + 2;
   const int ny = size_.y() + 2;
-  const int nz = size_.z() + 2;
+  const int nz = edt_nz_ + 2;
   const std::size_t n = static_cast<std::size_t>(nx) * ny * nz;
   auto pidx = [&](int x, int y, int z) { return (static_cast<std::size_t>(z) * ny + y) * nx + x; };
   std::vector<double> f(n, kFar);
@@ -146,8 +155,12 @@ void VoxelMap::computeDistanceField() {
   for (int z = 0; z < nz; ++z) {
     for (int y = 0; y < ny; ++y) {
       for (int x = 0; x < nx; ++x) {
-        const bool pad = x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 || z == nz - 1;
-        const bool blocked = pad || state_[static_cast<std::size_t>(flat(x - 1, y - 1, z - 1))] != VoxelState::kFree;
+        const bool pad_xy = x == 0 || y == 0 || x == nx - 1 || y == ny - 1;
+        const bool pad_z = z == 0 || z == nz - 1;
+        const bool outside_box = pad_xy || (z == 0 && edt_z0_ == 0) || (z == nz - 1 && edt_z0_ + edt_nz_ == size_.z());
+        if (pad_z && !outside_box) continue;  // beyond the band, not beyond the box: no obstacle known
+        const bool blocked =
+            outside_box || state_[static_cast<std::size_t>(flat(x - 1, y - 1, edt_z0_ + z - 1))] != VoxelState::kFree;
         if (blocked) {
           f[pidx(x, y, z)] = 0.0;
           site[pidx(x, y, z)] = static_cast<int>(pidx(x, y, z));
@@ -181,15 +194,15 @@ void VoxelMap::computeDistanceField() {
 }
 
 double VoxelMap::centreDistance(const Eigen::Vector3i& c) const {
-  const int nx = size_.x() + 2;
-  const int ny = size_.y() + 2;
-  const std::size_t i = (static_cast<std::size_t>(c.z() + 1) * ny + c.y() + 1) * nx + c.x() + 1;
-  return std::sqrt(static_cast<double>(dist2_[i])) * res_;
+  return std::sqrt(static_cast<double>(dist2_[padded(c)])) * res_;
 }
 
 double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
   const Eigen::Vector3i c = cellOf(p_W);
-  if (!inside(c) || state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] != VoxelState::kFree) return 0.0;
+  if (!inside(c) || c.z() < clear_z0_ || c.z() > clear_z1_ ||
+      state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] != VoxelState::kFree) {
+    return 0.0;
+  }
   // The nearest obstacle voxel of p is the nearest one of its own voxel or of a neighbour (the
   // feature transform is exact at centres); measure to that voxel's cube exactly.
   const int nx = size_.x() + 2;
@@ -199,11 +212,10 @@ double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        const Eigen::Vector3i q = c + Eigen::Vector3i(dx, dy, dz) + Eigen::Vector3i::Ones();  // padded
-        const int s = site_[(static_cast<std::size_t>(q.z()) * ny + q.y()) * nx + q.x()];
+        const int s = site_[padded(c + Eigen::Vector3i(dx, dy, dz))];
         if (s < 0) continue;
         const Eigen::Vector3d centre =
-            origin_ + res_ * Eigen::Vector3d(s % nx - 0.5, (s / nx) % ny - 0.5, s / (nx * ny) - 0.5);
+            origin_ + res_ * Eigen::Vector3d(s % nx - 0.5, (s / nx) % ny - 0.5, s / (nx * ny) - 0.5 + edt_z0_);
         const Eigen::Vector3d d = ((p_W - centre).cwiseAbs().array() - half).cwiseMax(0.0);
         best = std::min(best, d.norm());
       }
@@ -222,7 +234,7 @@ bool VoxelMap::segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   for (int i = 0; i <= steps; ++i) {
     const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(i) / steps);
     const Eigen::Vector3i c = cellOf(p);
-    if (inside(c) && centreDistance(c) - slack >= need) continue;
+    if (inside(c) && c.z() >= clear_z0_ && c.z() <= clear_z1_ && centreDistance(c) - slack >= need) continue;
     if (clearance(p) < need) return false;
   }
   return true;

@@ -29,8 +29,13 @@ struct LandmarkVoxel {
 class VoxelMap {
  public:
   // The box [min_W, max_W] is widened to whole octree voxels. Landmarks whose voxel lies
-  // outside it are not visible through this map.
-  VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W);
+  // outside it are not visible through this map. clearance() answers for heights in
+  // [clearance_z_lo_m, clearance_z_hi_m] (everything above or below counts as blocked): the
+  // distance field then covers only that band plus kClearanceReach_m, which is exact for every
+  // clearance up to kClearanceReach_m (planners only ask whether clearance >= robot radius).
+  VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W,
+           double clearance_z_lo_m = -1e9, double clearance_z_hi_m = 1e9);
+  static constexpr double kClearanceReach_m = 1.0;
 
   double resolution() const { return res_; }
   Eigen::Vector3i size() const { return size_; }
@@ -46,7 +51,8 @@ class VoxelMap {
   // True if the first occupied voxel from p towards voxel `index` is that voxel.
   bool lineOfSight(const Eigen::Vector3d& p_W, int index) const;
 
-  // Distance from p to the nearest obstacle voxel's cube (0 inside one; outside the box: 0).
+  // Distance from p to the nearest obstacle voxel's cube (0 inside one, outside the box or the
+  // clearance band).
   double clearance(const Eigen::Vector3d& p_W) const;
   // Every point of the segment keeps `clearance_m` (rigorous: sampled densely enough that
   // the 1-Lipschitz clearance cannot dip between samples).
@@ -70,8 +76,17 @@ class VoxelMap {
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i size_ = Eigen::Vector3i::Zero();
   std::vector<VoxelState> state_;
+  // Distance field over voxel layers [edt_z0_, edt_z0_ + edt_nz_), padded by one voxel on every
+  // side (obstacles where the padding lies outside the box, free where it is only outside the band).
+  int edt_z0_ = 0;
+  int edt_nz_ = 0;
+  int clear_z0_ = 0;  // voxel layers where clearance() answers
+  int clear_z1_ = 0;
+  std::size_t padded(const Eigen::Vector3i& c) const {
+    return (static_cast<std::size_t>(c.z() - edt_z0_ + 1) * (size_.y() + 2) + c.y() + 1) * (size_.x() + 2) + c.x() + 1;
+  }
   std::vector<float> dist2_;   // squared distance in voxels from each centre to the nearest obstacle centre
-  std::vector<int> site_;      // that obstacle voxel (flat index; -1: outside the box is nearest)
+  std::vector<int> site_;      // that obstacle voxel (padded flat index; -1: none within the band)
   std::vector<LandmarkVoxel> landmark_voxels_;
   std::vector<int> landmark_slot_;
 };

@@ -278,6 +278,75 @@ TEST(PoseGraph, WithoutPerceptionThePathIsTheReferenceLine) {
   std::cout << "[ figure   ] largest departure from the reference line with perception: " << off << " m\n";
 }
 
+// The graph's per-node information (summed per yaw over an azimuth window) agrees with the
+// direct per-pose computation of perception.h for every chosen pose, whatever the start yaw.
+TEST(PoseGraph, ChosenScoresMatchPoseScore) {
+  const Corridor& c = texturedCorridor(+1);
+  const VisibilityConfig vis;
+  const InformationConfig info;
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  int checked = 0;
+  for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
+    const PoseGraphResult r =
+        searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
+    ASSERT_TRUE(r.found);
+    for (std::size_t j = 0; j < r.path.size(); ++j) {
+      const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
+      const std::vector<WeightedPoint> points = aggregateByVoxel(c.voxels, seg.covisible);
+      const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
+      EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct))) << "start yaw " << start_yaw << " layer " << j;
+      EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
+      EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 50);
+}
+
+// PoseGraphConfig::validate() requires 2 pi / yaw_samples <= yaw_rate_limit * Ts "or the yaw
+// could never change", but the layers are spaced length / ceil(length / (v_nom Ts)), which can be
+// much less than v_nom Ts: the allowed turn per layer, yaw_rate_limit * spacing / v_nom, then
+// rounds down to zero yaw steps and the yaw is frozen along the whole path although the config
+// validated. Measured by the edge count: with the yaw frozen (rate limit ~0) the graph has exactly
+// as many edges as with the default limit.
+TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
+  const Corridor& c = texturedCorridor(+1);
+  const VisibilityConfig vis;
+  const PoseGraphConfig defaults;
+  ASSERT_NO_THROW(defaults.validate());
+  PoseGraphConfig frozen = defaults;
+  frozen.yaw_rate_limit_rad_s = 1e-6;
+  for (double length : {2.9, 2.41, 1.25, 0.81}) {
+    const std::vector<Eigen::Vector3d> path{{0.5, 1.5, kZ}, {0.5 + length, 1.5, kZ}};
+    const std::vector<PathSegment> segments = extractSegments(
+        path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+    const PoseGraphResult a = searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, defaults, std::nan(""), 9);
+    const PoseGraphResult b = searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, frozen, std::nan(""), 9);
+    ASSERT_TRUE(a.found);
+    ASSERT_EQ(a.nodes, b.nodes);
+    const double spacing = a.layer_s[1] - a.layer_s[0];
+    std::cout << "[ figure   ] path " << length << " m: layer spacing " << spacing << " m, allowed turn per layer "
+              << defaults.yaw_rate_limit_rad_s * spacing / defaults.nominal_speed_mps << " rad vs yaw step "
+              << 2.0 * M_PI / defaults.yaw_samples << " rad; edges " << a.edges << " (frozen yaw: " << b.edges << ")\n";
+    EXPECT_GT(a.edges, b.edges) << "path of " << length << " m: the yaw cannot change between any two layers";
+  }
+  // With yaw_samples = 21 (2 pi / 21 = 0.2992 <= 0.3 validates) every path whose length is not a
+  // multiple of v_nom Ts is affected, the 7 m corridor included.
+  PoseGraphConfig fine = defaults;
+  fine.yaw_samples = 21;
+  ASSERT_NO_THROW(fine.validate());
+  PoseGraphConfig fine_frozen = fine;
+  fine_frozen.yaw_rate_limit_rad_s = 1e-6;
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const PoseGraphResult a = searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine, std::nan(""), 9);
+  const PoseGraphResult b = searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine_frozen, std::nan(""), 9);
+  ASSERT_TRUE(a.found);
+  std::cout << "[ figure   ] 7 m corridor, 21 yaw samples: edges " << a.edges << " (frozen yaw: " << b.edges << ")\n";
+  EXPECT_GT(a.edges, b.edges) << "7 m path, 21 yaw samples: the yaw cannot change between any two layers";
+}
+
 void expectRejected(const PoseGraphConfig& config, const std::string& field) {
   try {
     config.validate();
