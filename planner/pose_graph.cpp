@@ -92,10 +92,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const int yaws = config.yaw_samples;
   const double yaw_step = 2.0 * M_PI / yaws;
   const double yaw0 = std::isnan(start_yaw_rad) ? 0.0 : start_yaw_rad;
+  // Every layer is one time step Ts (layers are at most v_nom * Ts apart): the yaw may change by
+  // up to yaw_rate_limit * Ts between layers, at least one yaw interval by validate().
   const int max_yaw_steps =
       yaws == 1 ? 0
-                : std::min(yaws / 2, static_cast<int>(std::floor(config.yaw_rate_limit_rad_s * spacing /
-                                                                     config.nominal_speed_mps / yaw_step + 1e-9)));
+                : std::min(yaws / 2, static_cast<int>(std::floor(config.yaw_rate_limit_rad_s * config.time_step_s /
+                                                                     yaw_step + 1e-9)));
 
   // Landmarks of each segment's co-visible set, grouped by voxel once.
   std::vector<std::vector<WeightedPoint>> segment_points;
@@ -133,8 +135,9 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     int seg = 0;
     while (seg + 1 < static_cast<int>(segments.size()) && segments[static_cast<std::size_t>(seg)].s_end_m < s) ++seg;
     result.layer_segment[static_cast<std::size_t>(j)] = seg;
-    const std::vector<WeightedPoint>& points = segment_points.empty() ? std::vector<WeightedPoint>{}
-                                                                      : segment_points[static_cast<std::size_t>(seg)];
+    static const std::vector<WeightedPoint> kNone;
+    const std::vector<WeightedPoint>& points =
+        segment_points.empty() ? kNone : segment_points[static_cast<std::size_t>(seg)];
     auto& layer_positions = positions[static_cast<std::size_t>(j)];
     auto& layer_cost = dag.node_cost[static_cast<std::size_t>(j)];
     auto& layer_scores = scores[static_cast<std::size_t>(j)];

@@ -7,7 +7,7 @@
 // with yaw_samples yaws at equal intervals (the start's yaw among them). The first layer is the
 // start, the last the goal. Edges join consecutive layers only, where the straight move keeps
 // the robot radius from every 3D obstacle of the map and the yaw changes by at most
-// yaw_rate_limit * (interval / v_nom). A node's information I(n) sums the bearing Fisher
+// yaw_rate_limit * Ts (a layer is one time step; intervals are at most v_nom * Ts long). A node's information I(n) sums the bearing Fisher
 // information (eqs. 5-6) of the landmarks of its segment's co-visible set that are inside its
 // field of view. The path minimises (eq. 7)
 //     lambda_d * c_d(P) - lambda_p * c_p(P),   c_p(P) = (1/N) sum_i log det I(n_i)   (eq. 8)

@@ -202,7 +202,7 @@ void expectFeasible(const Corridor& c, const PoseGraphResult& r, const PoseGraph
     EXPECT_LE(spacing, config.nominal_speed_mps * config.time_step_s + 1e-12) << "layer " << j;
     EXPECT_TRUE(c.voxels.segmentClear(r.path[j - 1].p_WB, r.path[j].p_WB, config.robot_radius_m)) << "layer " << j;
     EXPECT_LE(std::abs(wrap(r.path[j].yaw_rad - r.path[j - 1].yaw_rad)),
-              config.yaw_rate_limit_rad_s * spacing / config.nominal_speed_mps + 1e-9)
+              config.yaw_rate_limit_rad_s * config.time_step_s + 1e-9)
         << "layer " << j;
     c_d += (r.path[j].p_WB - r.path[j - 1].p_WB).norm();
   }
@@ -304,12 +304,11 @@ TEST(PoseGraph, ChosenScoresMatchPoseScore) {
   EXPECT_GT(checked, 50);
 }
 
-// PoseGraphConfig::validate() requires 2 pi / yaw_samples <= yaw_rate_limit * Ts "or the yaw
-// could never change", but the layers are spaced length / ceil(length / (v_nom Ts)), which can be
-// much less than v_nom Ts: the allowed turn per layer, yaw_rate_limit * spacing / v_nom, then
-// rounds down to zero yaw steps and the yaw is frozen along the whole path although the config
-// validated. Measured by the edge count: with the yaw frozen (rate limit ~0) the graph has exactly
-// as many edges as with the default limit.
+// A layer is one time step Ts (layers are at most v_nom Ts apart), so whenever validate() passes
+// (2 pi / yaw_samples <= yaw_rate_limit * Ts) the yaw can turn by at least one interval between
+// layers, on any path length. Regression: the allowed turn used to scale with the layer spacing
+// (length / ceil(length / (v_nom Ts))), which froze the yaw on paths whose spacing fell short.
+// Measured by the edge count against a graph whose yaw is frozen (rate limit ~0).
 TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;
@@ -327,12 +326,11 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
     ASSERT_EQ(a.nodes, b.nodes);
     const double spacing = a.layer_s[1] - a.layer_s[0];
     std::cout << "[ figure   ] path " << length << " m: layer spacing " << spacing << " m, allowed turn per layer "
-              << defaults.yaw_rate_limit_rad_s * spacing / defaults.nominal_speed_mps << " rad vs yaw step "
+              << defaults.yaw_rate_limit_rad_s * defaults.time_step_s << " rad vs yaw step "
               << 2.0 * M_PI / defaults.yaw_samples << " rad; edges " << a.edges << " (frozen yaw: " << b.edges << ")\n";
     EXPECT_GT(a.edges, b.edges) << "path of " << length << " m: the yaw cannot change between any two layers";
   }
-  // With yaw_samples = 21 (2 pi / 21 = 0.2992 <= 0.3 validates) every path whose length is not a
-  // multiple of v_nom Ts is affected, the 7 m corridor included.
+  // yaw_samples = 21 (2 pi / 21 = 0.2992 <= 0.3) validates: the 7 m corridor's yaw can turn too.
   PoseGraphConfig fine = defaults;
   fine.yaw_samples = 21;
   ASSERT_NO_THROW(fine.validate());
