@@ -185,9 +185,9 @@ void runPlanScenario(const PlanOptions& opt) {
   const harness::Scenario scenario = harness::loadScenario(opt.scenario);
   const std::uint64_t seed = opt.seed >= 0 ? static_cast<std::uint64_t>(opt.seed) : scenario.seed;
   const std::filesystem::path out(opt.out);
-  harness::makeOutputDir(out);
   const planner::FeatureMap map = loadSceneMap(opt, scenario);
   const harness::PlanRun run = harness::runPlanner(scenario, map, name, seed, opt.samples);
+  harness::makeOutputDir(out);
   harness::writeFileAtomic(out / "plan.json", harness::planJson(scenario, run).dump(2) + "\n");
   harness::writeImageAtomic(out / "plan.png", harness::drawPlanImage(scenario, map, run));
   const planner::Plan& plan = run.report.plan;

@@ -268,5 +268,34 @@ TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
   EXPECT_EQ(tgnav("render --help").rc, 0);
 }
 
+TEST(CliPlanScenario, BadInputIsOneLineExit2AndWritesNothing) {
+  const auto dir = test::tempDir();
+  const auto out = dir / "out";
+  const std::string storage = (test::sourceDir() / "configs/scenarios/storage.yaml").string();
+  const auto bad_key = test::writeFile(dir / "bad.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                                             "\nseed: 1\nplanner: {selection: {c_p_treshold: 6}}\n");
+  const auto bad_eta = test::writeFile(dir / "eta.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                                             "\nseed: 1\nplanner: {segments: {covisibility_ratio: 1.5}}\n");
+  const struct {
+    std::string args;
+    std::string expect;
+  } cases[] = {
+      {"--scenario " + storage + " --planner dijkstra", "--planner: 'dijkstra'"},
+      {"--scenario " + storage + " --seed -3", "--seed: -3"},
+      {"--scenario " + storage + " --planner proposed --samples 10", "--samples"},
+      {"--scenario " + bad_key.string(), "planner.selection.c_p_treshold"},
+      {"--scenario " + bad_eta.string(), "covisibility_ratio = 1.5"},
+      {"--scenario " + storage + " --map " + (dir / "nomap").string(), "map.bt"},
+      {"--scenario " + storage + " --grid x.map", "excludes"},
+  };
+  for (const auto& c : cases) {
+    const CmdResult run = tgnav("plan " + c.args + " --out " + out.string());
+    EXPECT_EQ(run.rc, 2) << c.args << ": " << run.output;
+    EXPECT_EQ(lines(run.output), 1) << run.output;
+    EXPECT_NE(run.output.find(c.expect), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
+  }
+}
+
 }  // namespace
 }  // namespace tgnav
