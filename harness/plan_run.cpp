@@ -26,14 +26,10 @@ nlohmann::json poseRows(const std::vector<planner::Pose4>& path) {
   return rows;
 }
 
-// The topological class a path belongs to (winding angles around the same obstacles).
-int classOf(const planner::TopologicalPlanner& topo, const planner::TopoPlan& plan,
-            const std::vector<planner::Pose4>& path) {
-  std::vector<Eigen::Vector2d> xy;
-  for (const auto& p : path) xy.push_back(p.p_WB.head<2>());
-  const std::vector<double> h = topo.hSignature(xy);
+// The topological class with this H-signature (winding angles around the same obstacles).
+int classOf(const planner::TopoPlan& plan, const std::vector<double>& h_signature) {
   for (std::size_t i = 0; i < plan.classes.size(); ++i) {
-    if (planner::TopologicalPlanner::sameClass(h, plan.classes[i].h_signature)) return static_cast<int>(i);
+    if (planner::TopologicalPlanner::sameClass(h_signature, plan.classes[i].h_signature)) return static_cast<int>(i);
   }
   return -1;
 }
@@ -98,7 +94,8 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, Pla
         for (const auto& p : c.path) xy.push_back(p.p_WB.head<2>());
         c.h_signature = topo.hSignature(xy);
       }
-      run.chosen_topology_class = classOf(topo, run.report.topo, run.report.plan.path);
+      run.chosen_topology_class =
+          classOf(run.report.topo, run.report.plan.candidates[static_cast<std::size_t>(run.report.plan.chosen)].h_signature);
     }
     return run;
   }
