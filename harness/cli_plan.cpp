@@ -1,10 +1,10 @@
 // tgnav plan: on a scene's feature map (--scenario: proposed, agnostic or rrtstar), or
 // topological planning on a 2D occupancy grid (--grid: ROS map_server or MovingAI).
-#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
@@ -16,6 +16,7 @@
 #include "harness/plan_run.h"
 #include "harness/quiet_stderr.h"
 #include "harness/scenario.h"
+#include "harness/trajectory_csv.h"
 #include "planner/topological_planner.h"
 
 namespace tgnav::cli {
@@ -28,8 +29,8 @@ struct PlanOptions {
   std::string start;
   std::string goal;
   std::string planner;
-  long long seed = -1;   // -1: the scenario's
-  int samples = 0;       // 0: planner.yaml's rrt_star.samples
+  long long seed = -1;  // -1: the scenario's
+  int samples = 0;      // 0: planner.yaml's rrt_star.samples
   std::string map;
   std::string map_cache;
   std::string out;
@@ -79,7 +80,8 @@ cv::Mat drawPlan(const planner::OccupancyGrid2D& grid, const planner::TopoPlan& 
   }
   if (plan.chosen >= 0) {
     const auto& path = plan.classes[plan.chosen].path;
-    for (std::size_t i = 1; i < path.size(); ++i) cv::line(img, px(path[i - 1]), px(path[i]), cv::Scalar(0, 0, 220), 4, cv::LINE_AA);
+    for (std::size_t i = 1; i < path.size(); ++i)
+      cv::line(img, px(path[i - 1]), px(path[i]), cv::Scalar(0, 0, 220), 4, cv::LINE_AA);
   }
   cv::circle(img, px(start), 6, cv::Scalar(0, 170, 0), cv::FILLED);
   cv::circle(img, px(goal), 6, cv::Scalar(0, 0, 220), cv::FILLED);
@@ -113,8 +115,7 @@ void runPlanGrid(const PlanOptions& opt) {
     const bool is_start = plan.status == planner::PlanStatus::kInvalidStart;
     std::ostringstream msg;
     msg << (is_start ? "--start" : "--goal") << ": '" << (is_start ? opt.start : opt.goal) << "' in " << opt.grid
-        << " is outside the map, in an obstacle or within the robot radius (" << config.robot_radius_m
-        << " m) of one";
+        << " is outside the map, in an obstacle or within the robot radius (" << config.robot_radius_m << " m) of one";
     throw InputError(msg.str());
   }
 
@@ -122,8 +123,11 @@ void runPlanGrid(const PlanOptions& opt) {
   j["planner"] = "agnostic";
   j["status"] = planner::toString(plan.status);
   j["plan_time_s"] = plan_s;
-  j["map"] = {{"file", opt.grid}, {"width", grid.width}, {"height", grid.height},
-              {"resolution_m", grid.resolution_m}, {"origin", {grid.origin_m.x(), grid.origin_m.y()}}};
+  j["map"] = {{"file", opt.grid},
+              {"width", grid.width},
+              {"height", grid.height},
+              {"resolution_m", grid.resolution_m},
+              {"origin", {grid.origin_m.x(), grid.origin_m.y()}}};
   j["start"] = {start.x(), start.y()};
   j["goal"] = {goal.x(), goal.y()};
   j["robot_radius_m"] = config.robot_radius_m;
@@ -155,11 +159,13 @@ void runPlanGrid(const PlanOptions& opt) {
 planner::FeatureMap loadSceneMap(const PlanOptions& opt, const harness::Scenario& scenario) {
   std::filesystem::path dir = opt.map;
   if (dir.empty()) {
-    const std::filesystem::path cache = opt.map_cache.empty() ? harness::defaultCacheDir() : std::filesystem::path(opt.map_cache);
+    const std::filesystem::path cache =
+        opt.map_cache.empty() ? harness::defaultCacheDir() : std::filesystem::path(opt.map_cache);
     const bool tty = isatty(fileno(stderr)) != 0;
     const harness::CachedMap cached =
         harness::cachedFeatureMap(scenario.scene, harness::MapBuildConfig{}, cache, [&](int done, int total) {
-          if (tty && (done % 20 == 0 || done == total)) std::fprintf(stderr, "\rtgnav plan: mapping %d/%d frames", done, total);
+          if (tty && (done % 20 == 0 || done == total))
+            std::fprintf(stderr, "\rtgnav plan: mapping %d/%d frames", done, total);
         });
     if (tty && cached.built) std::fprintf(stderr, "\n");
     dir = cached.dir;
@@ -176,7 +182,8 @@ void runPlanScenario(const PlanOptions& opt) {
   if (!opt.start.empty() || !opt.goal.empty()) {
     throw InputError("--start/--goal: with --scenario, start and goal come from the scenario or its scene");
   }
-  const harness::PlannerName name = harness::parsePlannerName(opt.planner.empty() ? "proposed" : opt.planner, "--planner");
+  const harness::PlannerName name =
+      harness::parsePlannerName(opt.planner.empty() ? "proposed" : opt.planner, "--planner");
   if (opt.samples != 0 && name != harness::PlannerName::kRrtStar) {
     throw InputError("--samples: only the rrtstar planner takes a sample budget");
   }
@@ -188,15 +195,30 @@ void runPlanScenario(const PlanOptions& opt) {
   const planner::FeatureMap map = loadSceneMap(opt, scenario);
   const harness::PlanRun run = harness::runPlanner(scenario, map, name, seed, opt.samples);
   harness::makeOutputDir(out);
+  const planner::TrajectoryReport& tr = run.trajectory;
+  if (tr.trajectory) {
+    harness::writeFileAtomic(out / "trajectory.csv", harness::trajectoryCsv(harness::setpoints(
+                                                         run, scenario.planner.trajectory.sample_rate_hz)));
+  }
   harness::writeFileAtomic(out / "plan.json", harness::planJson(scenario, run).dump(2) + "\n");
   harness::writeImageAtomic(out / "plan.png", harness::drawPlanImage(scenario, map, run));
   const planner::Plan& plan = run.report.plan;
   if (plan.chosen >= 0) {
     const planner::CandidatePath& c = plan.candidates[static_cast<std::size_t>(plan.chosen)];
-    std::printf("tgnav plan: %s %s, %zu homology classes, chose class %d (%.2f m, c_p,min %.1f), %.3f s -> "
-                "%s/{plan.json,plan.png}\n",
-                harness::toString(name), planner::toString(plan.status), run.report.topo.classes.size(),
-                run.chosen_topology_class, c.length_m, c.c_p_min, run.plan_time_s(), out.string().c_str());
+    std::printf(
+        "tgnav plan: %s %s, %zu homology classes, chose class %d (%.2f m, c_p,min %.1f), %.3f s; "
+        "trajectory %s (%.1f s, clearance %.2f m, %.3f s) -> %s/{plan.json,plan.png%s}\n",
+        harness::toString(name), planner::toString(plan.status), run.report.topo.classes.size(),
+        run.chosen_topology_class, c.length_m, c.c_p_min, run.plan_time_s(), planner::toString(tr.status),
+        tr.duration_s, tr.min_clearance_m, run.trajectory_s, out.string().c_str(),
+        tr.trajectory ? ",trajectory.csv" : "");
+    if (tr.status == planner::TrajectoryStatus::kFallback) {
+      std::fprintf(stderr,
+                   "tgnav plan: trajectory optimisation failed (%s); trajectory.csv flies the path itself, "
+                   "stopping at every point\n",
+                   tr.reason.c_str());
+    }
+    if (!tr.trajectory) throw std::runtime_error("trajectory: " + tr.reason + " (plan.json and plan.png written)");
   } else {
     std::printf("tgnav plan: %s %s (no path from start to goal), %.3f s -> %s/{plan.json,plan.png}\n",
                 harness::toString(name), planner::toString(plan.status), run.plan_time_s(), out.string().c_str());
@@ -208,7 +230,8 @@ void runPlanScenario(const PlanOptions& opt) {
 void addPlanCommand(CLI::App& app) {
   auto opt = std::make_shared<PlanOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "plan", "Plan on a scene's feature map (--scenario) or on a 2D occupancy grid (--grid); writes plan.json, plan.png");
+      "plan",
+      "Plan on a scene's feature map (--scenario) or on a 2D occupancy grid (--grid); writes plan.json, plan.png");
   auto* scenario = cmd->add_option("--scenario", opt->scenario, "Scenario YAML (configs/scenarios/*.yaml)");
   auto* grid = cmd->add_option("--grid", opt->grid, "ROS map_server .yaml (+ .pgm) or MovingAI .map");
   scenario->excludes(grid);
@@ -217,12 +240,16 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--samples", opt->samples, "rrtstar: iteration budget N (default: planner config)");
   cmd->add_option("--seed", opt->seed, "Random seed (default: the scenario's)");
   cmd->add_option("--map", opt->map, "Feature map folder from `tgnav map` (default: cached by content)");
-  cmd->add_option("--map-cache", opt->map_cache, "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
+  cmd->add_option("--map-cache", opt->map_cache,
+                  "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
   cmd->add_option("--start", opt->start, "--grid: start X,Y in metres (map frame, y up)");
   cmd->add_option("--goal", opt->goal, "--grid: goal X,Y in metres (map frame, y up)");
-  cmd->add_option("--resolution", opt->resolution_m, "--grid: metres per cell of a MovingAI map")->capture_default_str();
-  cmd->add_option("--robot-radius", opt->robot_radius_m, "--grid: clearance kept from obstacles, metres")->capture_default_str();
-  cmd->add_option("--max-classes", opt->max_classes, "--grid: cap on the homology classes searched")->capture_default_str();
+  cmd->add_option("--resolution", opt->resolution_m, "--grid: metres per cell of a MovingAI map")
+      ->capture_default_str();
+  cmd->add_option("--robot-radius", opt->robot_radius_m, "--grid: clearance kept from obstacles, metres")
+      ->capture_default_str();
+  cmd->add_option("--max-classes", opt->max_classes, "--grid: cap on the homology classes searched")
+      ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output directory")->required();
   cmd->callback([opt] {
     if (opt->scenario.empty() == opt->grid.empty()) throw InputError("plan: give one of --scenario FILE or --grid MAP");

@@ -34,7 +34,43 @@ int classOf(const planner::TopoPlan& plan, const std::vector<double>& h_signatur
   return -1;
 }
 
+// The chosen path as a trajectory from the scene's start pose (the vehicle may turn on the spot
+// first), kept at the configured clearance and in the path's homology class.
+void makeTrajectory(const Scenario& scenario, PlanRun* run) {
+  const planner::Plan& plan = run->report.plan;
+  if (plan.chosen < 0 || plan.path.empty()) {
+    run->trajectory = {};
+    run->trajectory.reason = "no path";
+    return;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  planner::TrajectoryRequest request;
+  request.path = plan.path;
+  request.start_yaw_rad = scenario.scene.start.yaw_rad;
+  request.obstacle_points = &run->report.topo.obstacle_points;
+  const planner::VoxelClearance field(*run->voxels);
+  run->trajectory = planner::generateTrajectory(request, field, scenario.planner.trajectory);
+  run->trajectory_s = since(t0);
+}
+
 }  // namespace
+
+control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz) {
+  if (!run.trajectory.trajectory) throw std::logic_error("setpoints: the plan has no trajectory");
+  std::vector<double> t;
+  std::vector<control::TrajectorySetpoint> sp;
+  for (const planner::TrajectorySample& s : planner::sampleTrajectory(*run.trajectory.trajectory, rate_hz)) {
+    t.push_back(s.t_s);
+    control::TrajectorySetpoint x;
+    x.p_WB = s.p_W;
+    x.v_WB = s.v_W;
+    x.a_WB = s.a_W;
+    x.yaw_rad = s.yaw_rad;
+    x.yaw_rate_rad_s = s.yaw_rate_rad_s;
+    sp.push_back(x);
+  }
+  return control::SetpointTrajectory(std::move(t), std::move(sp));
+}
 
 PlannerName parsePlannerName(const std::string& text, const std::string& option) {
   if (text == "proposed") return PlannerName::kProposed;
@@ -45,9 +81,12 @@ PlannerName parsePlannerName(const std::string& text, const std::string& option)
 
 const char* toString(PlannerName name) {
   switch (name) {
-    case PlannerName::kProposed: return "proposed";
-    case PlannerName::kAgnostic: return "agnostic";
-    case PlannerName::kRrtStar: return "rrtstar";
+    case PlannerName::kProposed:
+      return "proposed";
+    case PlannerName::kAgnostic:
+      return "agnostic";
+    case PlannerName::kRrtStar:
+      return "rrtstar";
   }
   return "?";
 }
@@ -94,17 +133,18 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, Pla
         for (const auto& p : c.path) xy.push_back(p.p_WB.head<2>());
         c.h_signature = topo.hSignature(xy);
       }
-      run.chosen_topology_class =
-          classOf(run.report.topo, run.report.plan.candidates[static_cast<std::size_t>(run.report.plan.chosen)].h_signature);
+      run.chosen_topology_class = classOf(
+          run.report.topo, run.report.plan.candidates[static_cast<std::size_t>(run.report.plan.chosen)].h_signature);
     }
+    makeTrajectory(scenario, &run);
     return run;
   }
-  run.report = perception.solve(scene.start, scene.goal,
-                                name == PlannerName::kProposed ? planner::PlannerKind::kProposed
-                                                               : planner::PlannerKind::kAgnostic,
-                                seed);
+  run.report = perception.solve(
+      scene.start, scene.goal,
+      name == PlannerName::kProposed ? planner::PlannerKind::kProposed : planner::PlannerKind::kAgnostic, seed);
   run.solve_s = since(t0);
   run.chosen_topology_class = run.report.plan.chosen;
+  makeTrajectory(scenario, &run);
   return run;
 }
 
@@ -123,7 +163,7 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   j["start"] = {s.p_WB.x(), s.p_WB.y(), s.p_WB.z(), s.yaw_rad};
   j["goal"] = {g.p_WB.x(), g.p_WB.y(), g.p_WB.z(), g.yaw_rad};
   j["flight_height_m"] = run.report.flight_height_m;
-  j["timing"] = {{"voxel_map_s", run.voxel_map_s}, {"solve_s", run.solve_s}};
+  j["timing"] = {{"voxel_map_s", run.voxel_map_s}, {"solve_s", run.solve_s}, {"trajectory_s", run.trajectory_s}};
   j["topology_classes"] = run.report.topo.classes.size();
   j["classes"] = nlohmann::json::array();
   for (std::size_t i = 0; i < plan.candidates.size(); ++i) {
@@ -138,8 +178,10 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
     if (i < run.report.details.size()) cj["visibility_queries"] = run.report.details[i].visibility_queries;
     cj["segments"] = nlohmann::json::array();
     for (const auto& seg : c.segments) {
-      cj["segments"].push_back(
-          {{"s_begin_m", seg.s_begin_m}, {"s_end_m", seg.s_end_m}, {"covisible", seg.covisible}, {"c_p", number(seg.c_p)}});
+      cj["segments"].push_back({{"s_begin_m", seg.s_begin_m},
+                                {"s_end_m", seg.s_end_m},
+                                {"covisible", seg.covisible},
+                                {"c_p", number(seg.c_p)}});
     }
     cj["waypoints"] = poseRows(c.path);
     j["classes"].push_back(cj);
@@ -151,6 +193,30 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   for (std::size_t i = 1; i < plan.path.size(); ++i) length += (plan.path[i].p_WB - plan.path[i - 1].p_WB).norm();
   j["path_length_m"] = length;
   j["path"] = poseRows(plan.path);
+  const planner::TrajectoryReport& tr = run.trajectory;
+  const planner::TrajectoryConfig& tc = scenario.planner.trajectory;
+  nlohmann::ordered_json tj;
+  tj["status"] = planner::toString(tr.status);
+  tj["reason"] = tr.reason;
+  tj["file"] = tr.trajectory ? nlohmann::json("trajectory.csv") : nlohmann::json(nullptr);
+  if (tr.trajectory) {
+    tj["duration_s"] = tr.duration_s;
+    tj["length_m"] = tr.length_m;
+    tj["min_clearance_m"] = tr.min_clearance_m;
+    tj["clearance_target_m"] = tc.margin_m();
+    tj["margin_met"] = tr.margin_met;
+    tj["max_speed_mps"] = tr.max_speed_mps;
+    tj["max_accel_mps2"] = tr.max_accel_mps2;
+    tj["max_yaw_rate_rad_s"] = tr.max_yaw_rate_rad_s;
+    tj["limits"] = {
+        {"speed_mps", tc.max_speed_mps}, {"accel_mps2", tc.max_accel_mps2}, {"yaw_rate_rad_s", tc.max_yaw_rate_rad_s}};
+    tj["same_homology"] = tr.homology_checked ? nlohmann::json(tr.same_homology) : nlohmann::json(nullptr);
+    tj["iterations"] = tr.iterations;
+    tj["retimes"] = tr.retimes;
+    tj["time_scale"] = tr.time_scale;
+    tj["sample_rate_hz"] = tc.sample_rate_hz;
+  }
+  j["trajectory"] = tj;
   return j;
 }
 
@@ -188,13 +254,21 @@ cv::Mat drawPlanImage(const Scenario& scenario, const planner::FeatureMap& map, 
   }
   if (plan.chosen >= 0) {
     polyline(plan.path, cv::Scalar(200, 60, 0), 3);
+    if (run.trajectory.trajectory) {  // the smooth trajectory over the path (thin, dark)
+      const auto samples = planner::sampleTrajectory(*run.trajectory.trajectory, 10.0);
+      for (std::size_t i = 1; i < samples.size(); ++i) {
+        cv::line(img, top.toPixel(samples[i - 1].p_W.head<2>()), top.toPixel(samples[i].p_W.head<2>()),
+                 cv::Scalar(20, 20, 20), 2, cv::LINE_AA);
+      }
+    }
     double since_arrow = 1e9;
     for (std::size_t i = 0; i < plan.path.size(); ++i) {
       if (i > 0) since_arrow += (plan.path[i].p_WB - plan.path[i - 1].p_WB).norm();
       if (since_arrow < 0.8) continue;
       since_arrow = 0.0;
       const Eigen::Vector2d p = plan.path[i].p_WB.head<2>();
-      const Eigen::Vector2d tip = p + 0.5 * Eigen::Vector2d(std::cos(plan.path[i].yaw_rad), std::sin(plan.path[i].yaw_rad));
+      const Eigen::Vector2d tip =
+          p + 0.5 * Eigen::Vector2d(std::cos(plan.path[i].yaw_rad), std::sin(plan.path[i].yaw_rad));
       cv::arrowedLine(img, top.toPixel(p), top.toPixel(tip), cv::Scalar(120, 0, 120), 2, cv::LINE_AA, 0, 0.35);
     }
   }

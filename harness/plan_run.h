@@ -1,16 +1,17 @@
 #pragma once
 // One planning run on a scene's feature map (the "plan" stage of `tgnav plan` and `tgnav trial`):
 // the dense voxel map, then the chosen planner, timed, and its plan.json and plan.png.
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "control/trajectory.h"
 #include "harness/scenario.h"
 #include "planner/feature_map.h"
 #include "planner/perception_planner.h"
+#include "planner/trajectory_generator.h"
 #include "planner/voxel_map.h"
 
 namespace tgnav::harness {
@@ -23,13 +24,17 @@ const char* toString(PlannerName name);
 struct PlanRun {
   PlannerName planner = PlannerName::kProposed;
   std::uint64_t seed = 0;
-  int rrt_samples = 0;                       // rrtstar only
-  planner::PerceptionPlanReport report;      // plan, topological classes, per-class details
-  int chosen_topology_class = -1;            // class of the chosen path among report.topo.classes
+  int rrt_samples = 0;                   // rrtstar only
+  planner::PerceptionPlanReport report;  // plan, topological classes, per-class details
+  int chosen_topology_class = -1;        // class of the chosen path among report.topo.classes
   std::unique_ptr<planner::VoxelMap> voxels;
-  double voxel_map_s = 0.0;                  // wall time: dense voxel map + distance field
-  double solve_s = 0.0;                      // wall time: the planner itself
+  double voxel_map_s = 0.0;  // wall time: dense voxel map + distance field
+  double solve_s = 0.0;      // wall time: the planner itself
   double plan_time_s() const { return voxel_map_s + solve_s; }
+  // The chosen path as a flyable trajectory (status kFailed with an empty trajectory when there
+  // is no path or it cannot be flown); not part of plan_time_s.
+  planner::TrajectoryReport trajectory;
+  double trajectory_s = 0.0;  // wall time: trajectory generation
 };
 
 // Box of the dense voxel map: the scene's bounds widened by `margin_m` (walls lie just outside
@@ -38,6 +43,9 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, Pla
                    int rrt_samples);
 
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
+// The generated trajectory sampled at the configured rate, as the controller takes it (and
+// `tgnav fly --trajectory` reads it back from trajectory.csv). Requires a trajectory.
+control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz);
 // Map, every class coloured by perception quality (c_p,min vs c_p,thr), the chosen 4-DoF path
 // with yaw arrows, start and goal.
 cv::Mat drawPlanImage(const Scenario& scenario, const planner::FeatureMap& map, const PlanRun& run);

@@ -9,6 +9,7 @@ namespace tgnav::harness {
 void PlannerSettings::validate() const {
   perception.validate();
   rrt_star.validate();
+  trajectory.validate();
 }
 
 void readPlannerSettings(FieldReader r, PlannerSettings* s) {
@@ -76,10 +77,29 @@ void readPlannerSettings(FieldReader r, PlannerSettings* s) {
                      .read("c_p_threshold", q.c_p_threshold)
                      .finish();
                })
+      .section("trajectory",
+               [&](FieldReader g) {
+                 planner::TrajectoryConfig& t = s->trajectory;
+                 g.read("nominal_speed_mps", t.nominal_speed_mps)
+                     .read("nominal_accel_mps2", t.nominal_accel_mps2)
+                     .read("nominal_yaw_rate_rad_s", t.nominal_yaw_rate_rad_s)
+                     .read("max_speed_mps", t.max_speed_mps)
+                     .read("max_accel_mps2", t.max_accel_mps2)
+                     .read("max_yaw_rate_rad_s", t.max_yaw_rate_rad_s)
+                     .read("safety_margin_m", t.safety_margin_m)
+                     .read("knot_spacing_m", t.knot_spacing_m)
+                     .read("smoothing_length_m", t.smoothing_length_m)
+                     .read("clearance_weight", t.clearance_weight)
+                     .read("feasibility_weight", t.feasibility_weight)
+                     .read("max_iterations", t.max_iterations)
+                     .read("sample_rate_hz", t.sample_rate_hz)
+                     .finish();
+               })
       .finish();
   s->rrt_star.robot_radius_m = p.robot_radius_m;
   s->rrt_star.visibility = p.visibility;
   s->rrt_star.information = p.information;
+  s->trajectory.robot_radius_m = p.robot_radius_m;
 }
 
 void validatePlannerSettings(const PlannerSettings& s, const std::string& source) {

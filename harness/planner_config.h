@@ -5,6 +5,7 @@
 #include "harness/yaml_util.h"
 #include "planner/perception_planner.h"
 #include "planner/rrt_star.h"
+#include "planner/trajectory_generator.h"
 
 namespace tgnav::harness {
 
@@ -12,6 +13,7 @@ struct PlannerSettings {
   planner::PerceptionPlannerConfig perception;  // proposed and agnostic
   planner::RrtStarConfig rrt_star;              // its visibility, information and robot radius
                                                 // follow `perception`'s (one sensor, one robot)
+  planner::TrajectoryConfig trajectory;         // its robot radius is perception's too
   void validate() const;                        // std::invalid_argument naming the key
 };
 

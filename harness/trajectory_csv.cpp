@@ -1,6 +1,7 @@
 #include "harness/trajectory_csv.h"
 
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -57,8 +58,8 @@ control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file)
         bool known = false;
         for (const char* c : kColumns) known = known || fields[i] == c;
         if (!known) {
-          fail(line_no, "unknown column '" + fields[i] +
-                            "' (columns: t,x,y,z,yaw and optionally vx,vy,vz,ax,ay,az,yaw_rate)");
+          fail(line_no,
+               "unknown column '" + fields[i] + "' (columns: t,x,y,z,yaw and optionally vx,vy,vz,ax,ay,az,yaw_rate)");
         }
         if (!col.emplace(fields[i], static_cast<int>(i)).second) {
           fail(line_no, "column '" + fields[i] + "' appears twice");
@@ -67,8 +68,8 @@ control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file)
       for (const char* c : {"t", "x", "y", "z", "yaw"}) {
         if (!col.count(c)) fail(line_no, std::string("missing required column '") + c + "'");
       }
-      for (const auto& group : {std::array<const char*, 3>{"vx", "vy", "vz"},
-                                std::array<const char*, 3>{"ax", "ay", "az"}}) {
+      for (const auto& group :
+           {std::array<const char*, 3>{"vx", "vy", "vz"}, std::array<const char*, 3>{"ax", "ay", "az"}}) {
         const int present = static_cast<int>(col.count(group[0]) + col.count(group[1]) + col.count(group[2]));
         if (present != 0 && present != 3) {
           fail(line_no, std::string("columns ") + group[0] + "," + group[1] + "," + group[2] +
@@ -78,8 +79,8 @@ control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file)
       continue;
     }
     if (fields.size() != col.size()) {
-      fail(line_no, "row has " + std::to_string(fields.size()) + " fields, the header has " +
-                        std::to_string(col.size()));
+      fail(line_no,
+           "row has " + std::to_string(fields.size()) + " fields, the header has " + std::to_string(col.size()));
     }
     auto value = [&](const char* c, double fallback) {
       const auto it = col.find(c);
@@ -96,8 +97,8 @@ control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file)
     if (!times.empty() && !(t > times.back())) {
       char prev[64];
       std::snprintf(prev, sizeof(prev), "%g", times.back());
-      fail(line_no, "column 't' has value '" + fields[col["t"]] + "', not after the previous " + prev +
-                        " (time must increase)");
+      fail(line_no,
+           "column 't' has value '" + fields[col["t"]] + "', not after the previous " + prev + " (time must increase)");
     }
     control::TrajectorySetpoint sp;
     sp.p_WB = Eigen::Vector3d(value("x", 0), value("y", 0), value("z", 0));
@@ -114,16 +115,24 @@ control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file)
 }
 
 std::string trajectoryCsv(const control::SetpointTrajectory& trajectory) {
-  std::ostringstream out;
-  out.precision(10);
-  out << "t,x,y,z,yaw,vx,vy,vz,ax,ay,az,yaw_rate\n";
+  // Shortest text that reads back to the same double: exact round trip, no padding digits.
+  std::string out = "t,x,y,z,yaw,vx,vy,vz,ax,ay,az,yaw_rate\n";
+  char buf[32];
+  auto put = [&](double v, char end) {
+    const auto r = std::to_chars(buf, buf + sizeof(buf), v);
+    out.append(buf, r.ptr);
+    out.push_back(end);
+  };
   for (std::size_t i = 0; i < trajectory.times().size(); ++i) {
     const auto& s = trajectory.setpoints()[i];
-    out << trajectory.times()[i] << ',' << s.p_WB.x() << ',' << s.p_WB.y() << ',' << s.p_WB.z() << ','
-        << s.yaw_rad << ',' << s.v_WB.x() << ',' << s.v_WB.y() << ',' << s.v_WB.z() << ',' << s.a_WB.x()
-        << ',' << s.a_WB.y() << ',' << s.a_WB.z() << ',' << s.yaw_rate_rad_s << '\n';
+    put(trajectory.times()[i], ',');
+    for (int k = 0; k < 3; ++k) put(s.p_WB[k], ',');
+    put(s.yaw_rad, ',');
+    for (int k = 0; k < 3; ++k) put(s.v_WB[k], ',');
+    for (int k = 0; k < 3; ++k) put(s.a_WB[k], ',');
+    put(s.yaw_rate_rad_s, '\n');
   }
-  return out.str();
+  return out;
 }
 
 }  // namespace tgnav::harness

@@ -1,10 +1,10 @@
 #include "planner/distance_field.h"
 
-#include "planner/edt.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include "planner/edt.h"
 
 namespace tgnav::planner {
 
@@ -57,24 +57,34 @@ double DistanceField::centreDistance(int ix, int iy) const {
 
 Eigen::Vector2i DistanceField::nearestObstacle(int ix, int iy) const { return site_[padded(ix, iy)]; }
 
-double DistanceField::clearance(const Eigen::Vector2d& p_m) const {
+double DistanceField::clearance(const Eigen::Vector2d& p_m) const { return clearance(p_m, nullptr); }
+
+double DistanceField::clearance(const Eigen::Vector2d& p_m, Eigen::Vector2d* gradient) const {
+  if (gradient) gradient->setZero();
   const Eigen::Vector2i c = grid_.cellOf(p_m);
   if (grid_.isOccupied(c.x(), c.y())) return -1.0;
   // The nearest obstacle cell of p is the nearest of its own cell or of a neighbour cell (the
   // feature transform is exact at cell centres); measure to that cell's square exactly.
   const double half = 0.5 * grid_.resolution_m;
   double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector2d best_offset = Eigen::Vector2d::Zero();
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       const int nx = c.x() + dx;
       const int ny = c.y() + dy;
       if (nx < -1 || ny < -1 || nx > grid_.width || ny > grid_.height) continue;
       const Eigen::Vector2i site = site_[padded(nx, ny)];
-      const Eigen::Vector2d centre = grid_.centreOf(site.x(), site.y());
-      const Eigen::Vector2d d = ((p_m - centre).cwiseAbs().array() - half).cwiseMax(0.0);
-      best = std::min(best, d.norm());
+      const Eigen::Vector2d r = p_m - grid_.centreOf(site.x(), site.y());
+      // From the nearest point of the obstacle square to p.
+      const Eigen::Vector2d d = (r.cwiseAbs().array() - half).cwiseMax(0.0).matrix().cwiseProduct(r.cwiseSign());
+      const double n = d.norm();
+      if (n < best) {
+        best = n;
+        best_offset = d;
+      }
     }
   }
+  if (gradient && best > 0.0 && std::isfinite(best)) *gradient = best_offset / best;
   return best;
 }
 

@@ -20,6 +20,9 @@ class DistanceField {
   // Clearance of a point: its distance to the boundary of the nearest occupied cell (negative
   // inside an occupied cell or outside the map).
   double clearance(const Eigen::Vector2d& p_m) const;
+  // The same, and its gradient (unit vector away from the nearest obstacle; zero where the
+  // clearance is not positive).
+  double clearance(const Eigen::Vector2d& p_m, Eigen::Vector2d* gradient) const;
   // Nearest occupied cell of (ix, iy), in grid coordinates (may be -1 or width/height: the
   // padding ring outside the map).
   Eigen::Vector2i nearestObstacle(int ix, int iy) const;

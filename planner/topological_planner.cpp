@@ -1,11 +1,11 @@
 #include "planner/topological_planner.h"
 
-#include "planner/check.h"
-
 #include <algorithm>
 #include <cmath>
 #include <queue>
 #include <stdexcept>
+
+#include "planner/check.h"
 
 namespace tgnav::planner {
 
@@ -52,19 +52,24 @@ std::vector<Eigen::Vector2d> obstacleComponentPoints(const OccupancyGrid2D& grid
 struct SearchNode {
   double cost;
   int vertex;
-  int edge;     // edge taken to reach `vertex` (-1 at the root)
-  int parent;   // index into the node pool
+  int edge;    // edge taken to reach `vertex` (-1 at the root)
+  int parent;  // index into the node pool
 };
 
 }  // namespace
 
 const char* toString(PlanStatus status) {
   switch (status) {
-    case PlanStatus::kSolved: return "solved";
-    case PlanStatus::kNoPath: return "no_path";
-    case PlanStatus::kInvalidStart: return "invalid_start";
-    case PlanStatus::kInvalidGoal: return "invalid_goal";
-    case PlanStatus::kTimeout: return "timeout";
+    case PlanStatus::kSolved:
+      return "solved";
+    case PlanStatus::kNoPath:
+      return "no_path";
+    case PlanStatus::kInvalidStart:
+      return "invalid_start";
+    case PlanStatus::kInvalidGoal:
+      return "invalid_goal";
+    case PlanStatus::kTimeout:
+      return "timeout";
   }
   return "unknown";
 }
@@ -90,12 +95,17 @@ TopologicalPlanner::TopologicalPlanner(const OccupancyGrid2D& grid, const TopoPl
   obstacle_points_ = obstacleComponentPoints(grid);
 }
 
-std::vector<double> TopologicalPlanner::hSignature(const std::vector<Eigen::Vector2d>& path) const {
-  std::vector<double> w(obstacle_points_.size(), 0.0);
-  for (std::size_t k = 0; k < obstacle_points_.size(); ++k) {
-    for (std::size_t i = 1; i < path.size(); ++i) w[k] += windingOfSegment(path[i - 1], path[i], obstacle_points_[k]);
+std::vector<double> windingAngles(const std::vector<Eigen::Vector2d>& path,
+                                  const std::vector<Eigen::Vector2d>& obstacle_points) {
+  std::vector<double> w(obstacle_points.size(), 0.0);
+  for (std::size_t k = 0; k < obstacle_points.size(); ++k) {
+    for (std::size_t i = 1; i < path.size(); ++i) w[k] += windingOfSegment(path[i - 1], path[i], obstacle_points[k]);
   }
   return w;
+}
+
+std::vector<double> TopologicalPlanner::hSignature(const std::vector<Eigen::Vector2d>& path) const {
+  return windingAngles(path, obstacle_points_);
 }
 
 bool TopologicalPlanner::sameClass(const std::vector<double>& a, const std::vector<double>& b) {
@@ -189,8 +199,7 @@ TopoPlan TopologicalPlanner::solve(const Eigen::Vector2d& start, const Eigen::Ve
   auto attach = [&](const Eigen::Vector2d& p) -> Eigen::Vector2i {
     std::vector<std::pair<double, Eigen::Vector2i>> by_distance;
     for (const auto& c : cells) by_distance.emplace_back((grid.centreOf(c.x(), c.y()) - p).squaredNorm(), c);
-    std::sort(by_distance.begin(), by_distance.end(),
-              [](const auto& u, const auto& v) { return u.first < v.first; });
+    std::sort(by_distance.begin(), by_distance.end(), [](const auto& u, const auto& v) { return u.first < v.first; });
     for (const auto& [d2, c] : by_distance) {
       if (field_.segmentClear(p, grid.centreOf(c.x(), c.y()), r)) return c;
     }

@@ -23,27 +23,27 @@ const char* toString(PlanStatus status);
 struct TopoPlannerConfig {
   double robot_radius_m = 0.3;
   double min_spur_length_m = 0.5;
-  int max_classes = 10;              // cap on homology classes
-  int max_expansions = 100000;       // cap on search effort (partial paths expanded)
-  double max_length_ratio = 3.0;     // graph paths longer than this x the shortest are not searched
+  int max_classes = 10;           // cap on homology classes
+  int max_expansions = 100000;    // cap on search effort (partial paths expanded)
+  double max_length_ratio = 3.0;  // graph paths longer than this x the shortest are not searched
 
   void validate() const;
 };
 
 struct HomologyClass {
-  std::vector<double> h_signature;       // winding angle [rad] around each obstacle component
+  std::vector<double> h_signature;          // winding angle [rad] around each obstacle component
   std::vector<Eigen::Vector2d> graph_path;  // along the GVD
-  std::vector<Eigen::Vector2d> path;     // shortened within the class
-  double length_m = 0.0;                 // of `path`
+  std::vector<Eigen::Vector2d> path;        // shortened within the class
+  double length_m = 0.0;                    // of `path`
 };
 
 struct TopoPlan {
   PlanStatus status = PlanStatus::kNoPath;
-  std::vector<HomologyClass> classes;    // sorted by length
-  int chosen = -1;                       // the AP planner's choice: the shortest class
+  std::vector<HomologyClass> classes;  // sorted by length
+  int chosen = -1;                     // the AP planner's choice: the shortest class
   int expansions = 0;
-  std::vector<std::uint8_t> gvd;         // skeleton mask (for plots)
-  TopoGraph graph;                       // with start/goal attached
+  std::vector<std::uint8_t> gvd;                 // skeleton mask (for plots)
+  TopoGraph graph;                               // with start/goal attached
   std::vector<Eigen::Vector2d> obstacle_points;  // one point per obstacle component
 };
 
@@ -68,5 +68,8 @@ class TopologicalPlanner {
 };
 
 double polylineLength(const std::vector<Eigen::Vector2d>& path);
+// Winding angle [rad] of a polyline around each point (the H-signature; TopoPlan::obstacle_points).
+std::vector<double> windingAngles(const std::vector<Eigen::Vector2d>& path,
+                                  const std::vector<Eigen::Vector2d>& obstacle_points);
 
 }  // namespace tgnav::planner

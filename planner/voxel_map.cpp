@@ -33,7 +33,8 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
     const Eigen::Vector3d c(it.getX(), it.getY(), it.getZ());
     // Leaves may be merged cubes of many voxels: fill every voxel they cover inside the box.
     const Eigen::Vector3i a = cellOf(c - Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMax(0);
-    const Eigen::Vector3i b = cellOf(c + Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMin(size_ - Eigen::Vector3i::Ones());
+    const Eigen::Vector3i b =
+        cellOf(c + Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMin(size_ - Eigen::Vector3i::Ones());
     for (int z = a.z(); z <= b.z(); ++z) {
       for (int y = a.y(); y <= b.y(); ++y) {
         for (int x = a.x(); x <= b.x(); ++x) state_[static_cast<std::size_t>(flat(x, y, z))] = s;
@@ -197,7 +198,10 @@ double VoxelMap::centreDistance(const Eigen::Vector3i& c) const {
   return std::sqrt(static_cast<double>(dist2_[padded(c)])) * res_;
 }
 
-double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
+double VoxelMap::clearance(const Eigen::Vector3d& p_W) const { return clearance(p_W, nullptr); }
+
+double VoxelMap::clearance(const Eigen::Vector3d& p_W, Eigen::Vector3d* gradient) const {
+  if (gradient) gradient->setZero();
   const Eigen::Vector3i c = cellOf(p_W);
   if (!inside(c) || c.z() < clear_z0_ || c.z() > clear_z1_ ||
       state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] != VoxelState::kFree) {
@@ -209,6 +213,7 @@ double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
   const int ny = size_.y() + 2;
   const double half = 0.5 * res_;
   double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d best_offset = Eigen::Vector3d::Zero();
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
@@ -216,11 +221,18 @@ double VoxelMap::clearance(const Eigen::Vector3d& p_W) const {
         if (s < 0) continue;
         const Eigen::Vector3d centre =
             origin_ + res_ * Eigen::Vector3d(s % nx - 0.5, (s / nx) % ny - 0.5, s / (nx * ny) - 0.5 + edt_z0_);
-        const Eigen::Vector3d d = ((p_W - centre).cwiseAbs().array() - half).cwiseMax(0.0);
-        best = std::min(best, d.norm());
+        const Eigen::Vector3d r = p_W - centre;
+        // From the nearest point of the obstacle cube to p.
+        const Eigen::Vector3d d = (r.cwiseAbs().array() - half).cwiseMax(0.0).matrix().cwiseProduct(r.cwiseSign());
+        const double n = d.norm();
+        if (n < best) {
+          best = n;
+          best_offset = d;
+        }
       }
     }
   }
+  if (gradient && best > 0.0 && std::isfinite(best)) *gradient = best_offset / best;
   return best;
 }
 

@@ -54,6 +54,9 @@ class VoxelMap {
   // Distance from p to the nearest obstacle voxel's cube (0 inside one, outside the box or the
   // clearance band).
   double clearance(const Eigen::Vector3d& p_W) const;
+  // The same, and its gradient (unit vector away from the nearest obstacle; zero where the
+  // clearance is 0 or beyond the field's reach).
+  double clearance(const Eigen::Vector3d& p_W, Eigen::Vector3d* gradient) const;
   // Every point of the segment keeps `clearance_m` (rigorous: sampled densely enough that
   // the 1-Lipschitz clearance cannot dip between samples).
   bool segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m) const;

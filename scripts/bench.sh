@@ -2,7 +2,8 @@
 # Builds the Google Benchmark targets (build-bench/, Release) and prints one table of figures
 # with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
 # the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
-# storage and gallery with every planner (results/bench/plans/).
+# storage and gallery with every planner (results/bench/plans/), which also times trajectory
+# generation on the chosen paths.
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -62,12 +63,15 @@ for key, runs in groups.items():
     times = sorted(p["plan_time_s"] for p in runs)
     rows.append({"benchmark": f"plan/{key}", "figure": "median_plan_s", "value": times[len(times) // 2]})
     rows.append({"benchmark": f"plan/{key}", "figure": "path_length_m", "value": runs[0]["path_length_m"]})
+    trajectory_s = sorted(p["timing"]["trajectory_s"] for p in runs)
+    rows.append({"benchmark": f"plan/{key}", "figure": "median_traj_s", "value": trajectory_s[len(trajectory_s) // 2]})
 for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "bench.json"):
     data = json.load(open(os.path.join(out, name)))
     for b in data["benchmarks"]:
         for key, value in b.items():
             if key in ("ms_per_frame", "us_per_step", "us_per_cycle", "real_time_factor", "queries_per_s",
-                       "landmarks_per_query", "ms_per_plan", "classes"):
+                       "landmarks_per_query", "ms_per_plan", "classes", "ms_per_trajectory",
+                       "path_length_m", "optimised"):
                 rows.append({"benchmark": b["name"], "figure": key, "value": value})
 meta = {"git_sha": sha, "host": socket.gethostname(), "cpus": os.cpu_count(),
         "date": datetime.datetime.now().isoformat(timespec="seconds")}

@@ -11,6 +11,7 @@ packages=(
   libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri   # headless EGL, llvmpipe software GL
   libeigen3-dev libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev liboctomap-dev
   libompl-dev libtbb-dev              # RRT* baseline; homology classes evaluated in parallel
+  liblbfgspp-dev                      # trajectory optimisation (L-BFGS)
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL's CMake links these
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -6,6 +6,7 @@
 #include "harness/scene_config.h"
 #include "harness/scene_geometry.h"
 #include "planner/topological_planner.h"
+#include "planner/trajectory_generator.h"
 
 namespace tgnav::harness {
 namespace {
@@ -46,6 +47,37 @@ void BM_TopologicalPlanGallery(benchmark::State& state) {
   state.counters["cells"] = static_cast<double>(g.grid.width) * g.grid.height;
 }
 BENCHMARK(BM_TopologicalPlanGallery)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Trajectory generation (B-spline position + yaw optimisation, checks) for the shortest gallery
+// class of at least 40 m, with the yaw along the direction of travel, at the default settings.
+void BM_TrajectoryGallery40m(benchmark::State& state) {
+  static const GalleryGrid g;
+  static const planner::TopologicalPlanner topo(g.grid, planner::TopoPlannerConfig{});
+  static const planner::TopoPlan plan = topo.solve(g.scene.start.p_WB.head<2>(), g.scene.goal.p_WB.head<2>());
+  std::size_t best = plan.classes.size() - 1;  // sorted by length
+  for (std::size_t i = plan.classes.size(); i-- > 0;) {
+    if (plan.classes[i].length_m >= 40.0) best = i;
+  }
+  const auto& path = plan.classes[best].path;
+  planner::TrajectoryRequest request;
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    const Eigen::Vector2d d = path[std::min(i + 1, path.size() - 1)] - path[i == path.size() - 1 ? i - 1 : i];
+    request.path.push_back(
+        {Eigen::Vector3d(path[i].x(), path[i].y(), g.scene.flight_height_m), std::atan2(d.y(), d.x())});
+  }
+  request.start_yaw_rad = g.scene.start.yaw_rad;
+  request.obstacle_points = &plan.obstacle_points;
+  const planner::PlanarClearance field(topo.field());
+  planner::TrajectoryReport report;
+  for (auto _ : state) report = planner::generateTrajectory(request, field, planner::TrajectoryConfig{});
+  state.counters["ms_per_trajectory"] = benchmark::Counter(static_cast<double>(state.iterations()) / 1000.0,
+                                                           benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["path_length_m"] = plan.classes[best].length_m;
+  state.counters["duration_s"] = report.duration_s;
+  state.counters["iterations"] = report.iterations;
+  state.counters["optimised"] = report.status == planner::TrajectoryStatus::kOptimised;
+}
+BENCHMARK(BM_TrajectoryGallery40m)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace tgnav::harness
