@@ -37,8 +37,8 @@ int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), 
 
 TEST(CliRender, WritesImagesAndIntrinsics) {
   const auto out = test::tempDir() / "out";
-  const CmdResult run = tgnav("render --scene " + smoke() + " --pose 1.2,0.2,1,0 --width 320 --height 240 --out " +
-                        out.string());
+  const CmdResult run =
+      tgnav("render --scene " + smoke() + " --pose 1.2,0.2,1,0 --width 320 --height 240 --out " + out.string());
   ASSERT_EQ(run.rc, 0) << run.output;
   const cv::Mat rgb = cv::imread((out / "rgb.png").string(), cv::IMREAD_UNCHANGED);
   const cv::Mat depth = cv::imread((out / "depth.png").string(), cv::IMREAD_UNCHANGED);
@@ -96,16 +96,13 @@ TEST(CliRender, BadResolutionNamesTheValue) {
 
 TEST(CliRender, MissingEglSaysWhatToInstall) {
   const CmdResult run = tgnav("render --scene " + smoke() + " --out " + (test::tempDir() / "o").string(),
-                        "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json");
+                              "__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json");
   EXPECT_EQ(run.rc, 2);
   EXPECT_EQ(lines(run.output), 1) << run.output;
-  EXPECT_NE(run.output.find("install libegl1 libegl-mesa0 libgl1-mesa-dri"), std::string::npos)
-      << run.output;
+  EXPECT_NE(run.output.find("install libegl1 libegl-mesa0 libgl1-mesa-dri"), std::string::npos) << run.output;
 }
 
-std::string pillarCsv() {
-  return (test::sourceDir() / "configs/trajectories/smoke_around_pillar.csv").string();
-}
+std::string pillarCsv() { return (test::sourceDir() / "configs/trajectories/smoke_around_pillar.csv").string(); }
 
 TEST(CliFly, FliesAroundThePillarAndWritesResults) {
   const auto out = test::tempDir() / "out";
@@ -128,7 +125,8 @@ TEST(CliFly, FliesAroundThePillarAndWritesResults) {
 TEST(CliFly, BadTrajectoryIsOneLineExit2AndWritesNothing) {
   const auto dir = test::tempDir();
   const auto csv = test::writeFile(dir / "bad.csv", "t,x,y,z,yaw\n0,-3,0,1,0\n2,-2,0,1,0\n1,-1,0,1,0\n");
-  const CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + csv.string() + " --out " + (dir / "o").string());
+  const CmdResult run =
+      tgnav("fly --scene " + smoke() + " --trajectory " + csv.string() + " --out " + (dir / "o").string());
   EXPECT_EQ(run.rc, 2);
   EXPECT_EQ(lines(run.output), 1) << run.output;
   EXPECT_NE(run.output.find(csv.string() + ":4: column 't' has value '1'"), std::string::npos) << run.output;
@@ -198,8 +196,8 @@ TEST(CliMap, RefusesToOverwriteSomethingElse) {
 
 TEST(CliMap, UnreadableTextureNamesTheMjcfAndTexture) {
   const auto dir = test::tempDir();
-  const auto xml = test::writeFile(dir / "scene.xml",
-                                   "<mujoco><asset><texture name='t' type='cube' file='missing.png'/></asset></mujoco>");
+  const auto xml = test::writeFile(
+      dir / "scene.xml", "<mujoco><asset><texture name='t' type='cube' file='missing.png'/></asset></mujoco>");
   const CmdResult run = tgnav("render --scene " + xml.string() + " --pose 0,0,1,0 --out " + (dir / "o").string());
   EXPECT_EQ(run.rc, 2);
   // MuJoCo 2.2 names the texture and its line, not the PNG's path.
@@ -224,13 +222,14 @@ std::filesystem::path twoPillars(const std::filesystem::path& dir) {
 
 TEST(CliPlan, GridPlanWritesClassesAndPicture) {
   const auto dir = test::tempDir();
-  const CmdResult run = tgnav("plan --grid " + twoPillars(dir).string() + " --start 1.5,6 --goal 18.5,6 --out " +
-                              (dir / "p").string());
+  const CmdResult run =
+      tgnav("plan --grid " + twoPillars(dir).string() + " --start 1.5,6 --goal 18.5,6 --out " + (dir / "p").string());
   ASSERT_EQ(run.rc, 0) << run.output;
   EXPECT_NE(run.output.find("solved, 4 homology classes"), std::string::npos) << run.output;
   std::ifstream json(dir / "p" / "plan.json");
   const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
-  for (const char* key : {"\"classes\"", "\"h_signature\"", "\"waypoints\"", "\"chosen_class\": 0", "\"class_cap\": 10"}) {
+  for (const char* key :
+       {"\"classes\"", "\"h_signature\"", "\"waypoints\"", "\"chosen_class\": 0", "\"class_cap\": 10"}) {
     EXPECT_NE(text.find(key), std::string::npos) << key;
   }
   EXPECT_FALSE(cv::imread((dir / "p" / "plan.png").string()).empty());
@@ -272,15 +271,26 @@ TEST(CliPlanScenario, BadInputIsOneLineExit2AndWritesNothing) {
   const auto dir = test::tempDir();
   const auto out = dir / "out";
   const std::string storage = (test::sourceDir() / "configs/scenarios/storage.yaml").string();
-  const auto bad_key = test::writeFile(dir / "bad.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
-                                                             "\nseed: 1\nplanner: {selection: {c_p_treshold: 6}}\n");
-  const auto bad_eta = test::writeFile(dir / "eta.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
-                                                             "\nseed: 1\nplanner: {segments: {covisibility_ratio: 1.5}}\n");
+  const auto bad_key =
+      test::writeFile(dir / "bad.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                            "\nseed: 1\nplanner: {selection: {c_p_treshold: 6}}\n");
+  const auto bad_eta =
+      test::writeFile(dir / "eta.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                            "\nseed: 1\nplanner: {segments: {covisibility_ratio: 1.5}}\n");
+  const auto bad_traj_key =
+      test::writeFile(dir / "traj_key.yaml", "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                                 "\nseed: 1\nplanner: {trajectory: {max_sped_mps: 2}}\n");
+  const auto bad_traj_speed = test::writeFile(dir / "traj_speed.yaml",
+                                              "scene: " + (test::sourceDir() / "configs/scenes/storage.yaml").string() +
+                                                  "\nseed: 1\nplanner: {trajectory: {nominal_speed_mps: 2.5}}\n");
   const struct {
     std::string args;
     std::string expect;
   } cases[] = {
       {"--scenario " + storage + " --planner dijkstra", "--planner: 'dijkstra'"},
+      {"--scenario " + bad_traj_key.string(), "planner.trajectory.max_sped_mps"},
+      {"--scenario " + bad_traj_speed.string(),
+       "trajectory.nominal_speed_mps = 2.5: must be <= trajectory.max_speed_mps"},
       {"--scenario " + storage + " --seed -3", "--seed: -3"},
       {"--scenario " + storage + " --planner proposed --samples 10", "--samples"},
       {"--scenario " + bad_key.string(), "planner.selection.c_p_treshold"},
