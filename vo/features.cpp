@@ -19,20 +19,16 @@ void FeatureConfig::validate() const {
   require(max_features > 0, "max_features", max_features, "must be > 0");
   require(grid_cols > 0 && grid_cols <= 64, "grid_cols", grid_cols, "must be in [1, 64]");
   require(grid_rows > 0 && grid_rows <= 64, "grid_rows", grid_rows, "must be in [1, 64]");
-  require(fast_threshold > 0 && fast_threshold < 255, "fast_threshold", fast_threshold,
-          "must be in [1, 254]");
-  require(scale_factor > 1.0 && scale_factor <= 2.0, "scale_factor", scale_factor,
-          "must be in (1, 2]");
-  require(pyramid_levels >= 1 && pyramid_levels <= 16, "pyramid_levels", pyramid_levels,
-          "must be in [1, 16]");
+  require(fast_threshold > 0 && fast_threshold < 255, "fast_threshold", fast_threshold, "must be in [1, 254]");
+  require(scale_factor > 1.0 && scale_factor <= 2.0, "scale_factor", scale_factor, "must be in (1, 2]");
+  require(pyramid_levels >= 1 && pyramid_levels <= 16, "pyramid_levels", pyramid_levels, "must be in [1, 16]");
   require(edge_threshold_px >= 3, "edge_threshold_px", edge_threshold_px, "must be >= 3");
 }
 
 FeatureDetector::FeatureDetector(const FeatureConfig& config) : config_(config) {
   config_.validate();
-  orb_ = cv::ORB::create(kCandidateFactor * config_.max_features,
-                         static_cast<float>(config_.scale_factor), config_.pyramid_levels,
-                         config_.edge_threshold_px, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+  orb_ = cv::ORB::create(kCandidateFactor * config_.max_features, static_cast<float>(config_.scale_factor),
+                         config_.pyramid_levels, config_.edge_threshold_px, 0, 2, cv::ORB::HARRIS_SCORE, 31,
                          config_.fast_threshold);
 }
 

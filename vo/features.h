@@ -11,7 +11,7 @@ struct FeatureConfig {
   int max_features = 1000;
   int grid_cols = 8;
   int grid_rows = 6;
-  int fast_threshold = 20;   // FAST intensity threshold (8-bit units), ORB-SLAM2's iniThFAST
+  int fast_threshold = 20;  // FAST intensity threshold (8-bit units), ORB-SLAM2's iniThFAST
   double scale_factor = 1.2;
   int pyramid_levels = 8;
   int edge_threshold_px = 19;

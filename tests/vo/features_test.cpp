@@ -1,11 +1,11 @@
 // Grid-bucketed ORB: features spread over textured cells, the budget holds, blank images give
 // none, and the result is deterministic.
+#include "vo/features.h"
+
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 #include <random>
-
-#include "vo/features.h"
 
 namespace tgnav::vo {
 namespace {
@@ -43,8 +43,7 @@ TEST(FeatureDetector, FeaturesSpreadOverEveryTexturedCell) {
   // Fine, strong texture on the left half; coarse texture on the right half. Without bucketing
   // the strong half would take the budget; with it every textured grid cell gets features.
   cv::Mat img = blocks({640, 480}, {0, 0, 320, 480}, 4, 2);
-  blocks({640, 480}, {320, 0, 320, 480}, 16, 3)(cv::Rect(320, 0, 320, 480))
-      .copyTo(img(cv::Rect(320, 0, 320, 480)));
+  blocks({640, 480}, {320, 0, 320, 480}, 16, 3)(cv::Rect(320, 0, 320, 480)).copyTo(img(cv::Rect(320, 0, 320, 480)));
   FeatureConfig config;
   config.max_features = 300;
   const Features f = FeatureDetector(config).detect(img);

@@ -1,0 +1,137 @@
+// RgbdOdometry on synthetic RGB-D frames: a textured plane 2 m ahead seen by a camera sliding
+// sideways (the image is a shifted crop of a larger texture, depth constant), and bad frames.
+#include "vo/odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+namespace tgnav::vo {
+namespace {
+
+constexpr int kW = 320;
+constexpr int kH = 240;
+constexpr double kF = 208.0;
+constexpr double kDepth = 2.0;
+
+CameraIntrinsics camera() { return CameraIntrinsics{kW, kH, kF, kF, (kW - 1) / 2.0, (kH - 1) / 2.0}; }
+
+// Blurred random blobs: plenty of corners at every scale.
+cv::Mat texture(int w, int h) {
+  cv::Mat t(h, w, CV_8UC1);
+  cv::RNG rng(3);
+  rng.fill(t, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(t, t, cv::Size(0, 0), 2.0);
+  cv::normalize(t, t, 0, 255, cv::NORM_MINMAX);
+  return t;
+}
+
+cv::Mat flatDepth(float z = static_cast<float>(kDepth)) { return cv::Mat(kH, kW, CV_32FC1, cv::Scalar(z)); }
+
+TEST(Odometry, TracksASidewaysSlideOverATexturedPlane) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  RgbdOdometry vo(camera(), OdometryConfig{});
+  // 4 px per frame to the right in the image = the camera moving along +x by 4 z / f.
+  for (int i = 0; i < 100; ++i) {
+    const cv::Mat image = tex(cv::Rect(4 * i, 0, kW, kH)).clone();
+    const FrameResult r = vo.track(0.05 * i, image, flatDepth());
+    ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+    const double truth = 4.0 * i * kDepth / kF;
+    EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 2e-3) << "frame " << i;
+    // A single plane leaves rotation and sideways translation weakly separable: small drift.
+    EXPECT_NEAR(r.X_WC.translation().y(), 0.0, 0.005 + 0.005 * truth) << "frame " << i;
+    EXPECT_NEAR(r.X_WC.translation().z(), 0.0, 0.01 + 0.01 * truth) << "frame " << i;
+    EXPECT_LT(Eigen::AngleAxisd(r.X_WC.linear()).angle(), 0.01) << "frame " << i;
+    if (i > 0) {
+      EXPECT_GE(r.inliers, 200) << "frame " << i;
+    }
+  }
+  EXPECT_FALSE(vo.failed());
+  EXPECT_GT(vo.history().back().features, 500);
+}
+
+TEST(Odometry, BlankSaturatedOrDepthlessFramesAreLost) {
+  const cv::Mat black(kH, kW, CV_8UC1, cv::Scalar(0));
+  const cv::Mat white(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255));
+  const cv::Mat tex = texture(kW, kH);
+  const cv::Mat no_depth(kH, kW, CV_32FC1, cv::Scalar(0.0f));
+  const cv::Mat nan_depth(kH, kW, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  struct Case {
+    const char* what;
+    cv::Mat image, depth;
+  } cases[] = {{"black", black, flatDepth()},
+               {"saturated", white, flatDepth()},
+               {"no depth", tex, no_depth},
+               {"NaN depth", tex, nan_depth},
+               {"too far", tex, flatDepth(20.0f)}};
+  for (const Case& c : cases) {
+    RgbdOdometry vo(camera(), OdometryConfig{});
+    const FrameResult r = vo.track(0.0, c.image, c.depth);
+    EXPECT_EQ(r.status, TrackingStatus::kLost) << c.what;
+    EXPECT_FALSE(r.reason.empty()) << c.what;
+    EXPECT_TRUE(vo.failed()) << c.what;
+    EXPECT_EQ(vo.failedAt(), 0.0) << c.what;
+  }
+}
+
+TEST(Odometry, LostStaysFailedUnlessReinitialisedWhichContinuesFromTheLastPose) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  const cv::Mat blank(kH, kW, CV_8UC1, cv::Scalar(128));
+  for (const bool reinit : {false, true}) {
+    OdometryConfig config;
+    config.reinitialise_after_lost = reinit;
+    RgbdOdometry vo(camera(), config);
+    for (int i = 0; i < 10; ++i) vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth());
+    const Eigen::Isometry3d before = vo.history().back().X_WC;
+    const FrameResult lost = vo.track(0.5, blank, flatDepth());  // a blank frame: nothing to match
+    EXPECT_EQ(lost.status, TrackingStatus::kLost);
+    EXPECT_TRUE(lost.X_WC.isApprox(before));
+    const FrameResult next = vo.track(0.55, tex(cv::Rect(44, 0, kW, kH)).clone(), flatDepth());
+    EXPECT_TRUE(vo.failed());
+    EXPECT_DOUBLE_EQ(vo.failedAt(), 0.5);
+    if (reinit) {
+      EXPECT_EQ(next.status, TrackingStatus::kOk) << next.reason;
+      EXPECT_TRUE(next.reinitialised);
+      EXPECT_TRUE(next.X_WC.isApprox(before));
+    } else {
+      EXPECT_EQ(next.status, TrackingStatus::kLost);
+      EXPECT_NE(next.reason.find("lost at t = 0.5"), std::string::npos) << next.reason;
+    }
+  }
+}
+
+TEST(Odometry, BadFramesAndConfigsAreRefused) {
+  RgbdOdometry vo(camera(), OdometryConfig{});
+  const cv::Mat tex = texture(kW, kH);
+  EXPECT_THROW(vo.track(0.0, cv::Mat(kH, kW + 1, CV_8UC1, cv::Scalar(0)), flatDepth()), std::invalid_argument);
+  EXPECT_THROW(vo.track(0.0, tex, cv::Mat(kH, kW, CV_16UC1, cv::Scalar(0))), std::invalid_argument);
+  EXPECT_THROW(vo.track(0.0, cv::Mat(), flatDepth()), std::invalid_argument);
+  vo.track(1.0, tex, flatDepth());
+  EXPECT_THROW(vo.track(1.0, tex, flatDepth()), std::invalid_argument);  // time must increase
+  EXPECT_THROW(vo.track(0.5, tex, flatDepth()), std::invalid_argument);
+  auto message = [](OdometryConfig c) {
+    try {
+      c.validate();
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  OdometryConfig c;
+  c.min_inliers = 2;
+  EXPECT_NE(message(c).find("min_inliers = 2"), std::string::npos);
+  c = OdometryConfig{};
+  c.weak_inliers = 10;
+  EXPECT_NE(message(c).find("weak_inliers = 10"), std::string::npos);
+  c = OdometryConfig{};
+  c.max_depth_m = 0.1;
+  EXPECT_NE(message(c).find("max_depth_m"), std::string::npos);
+  c = OdometryConfig{};
+  c.ratio_test = 1.5;
+  EXPECT_NE(message(c).find("ratio_test"), std::string::npos);
+  EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tgnav::vo

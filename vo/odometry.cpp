@@ -1,0 +1,426 @@
+#include "vo/odometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+namespace tgnav::vo {
+
+namespace {
+
+void require(bool ok, const std::string& field, double value, const std::string& rule) {
+  if (ok) return;
+  std::ostringstream msg;
+  msg << field << " = " << value << ": " << rule;
+  throw std::invalid_argument(msg.str());
+}
+
+double rotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
+
+// Keypoints bucketed on a coarse grid, for window searches around a predicted pixel.
+class KeypointGrid {
+ public:
+  KeypointGrid(const std::vector<cv::KeyPoint>& keypoints, int width, int height, double cell_px)
+      : cell_(cell_px),
+        cols_(std::max(1, static_cast<int>(std::ceil(width / cell_px)))),
+        rows_(std::max(1, static_cast<int>(std::ceil(height / cell_px)))),
+        cells_(static_cast<std::size_t>(cols_ * rows_)) {
+    for (std::size_t i = 0; i < keypoints.size(); ++i) {
+      const int cx = std::clamp(static_cast<int>(keypoints[i].pt.x / cell_), 0, cols_ - 1);
+      const int cy = std::clamp(static_cast<int>(keypoints[i].pt.y / cell_), 0, rows_ - 1);
+      cells_[static_cast<std::size_t>(cy * cols_ + cx)].push_back(static_cast<int>(i));
+    }
+  }
+  template <typename Fn>
+  void forEachNear(double u, double v, Fn fn) const {
+    const int cx = static_cast<int>(std::floor(u / cell_));
+    const int cy = static_cast<int>(std::floor(v / cell_));
+    for (int y = std::max(0, cy - 1); y <= std::min(rows_ - 1, cy + 1); ++y) {
+      for (int x = std::max(0, cx - 1); x <= std::min(cols_ - 1, cx + 1); ++x) {
+        for (int i : cells_[static_cast<std::size_t>(y * cols_ + x)]) fn(i);
+      }
+    }
+  }
+
+ private:
+  double cell_;
+  int cols_;
+  int rows_;
+  std::vector<std::vector<int>> cells_;
+};
+
+std::array<std::uint64_t, 4> descriptorBits(const cv::Mat& descriptors, int row) {
+  std::array<std::uint64_t, 4> bits{};
+  std::memcpy(bits.data(), descriptors.ptr<std::uint8_t>(row), sizeof(bits));
+  return bits;
+}
+
+int hamming(const std::array<std::uint64_t, 4>& a, const std::array<std::uint64_t, 4>& b) {
+  return __builtin_popcountll(a[0] ^ b[0]) + __builtin_popcountll(a[1] ^ b[1]) + __builtin_popcountll(a[2] ^ b[2]) +
+         __builtin_popcountll(a[3] ^ b[3]);
+}
+
+cv::Mat toGray(const cv::Mat& image) {
+  if (image.type() == CV_8UC1) return image;
+  cv::Mat gray;
+  cv::cvtColor(image, gray, cv::COLOR_BGR2GRAY);
+  return gray;
+}
+
+}  // namespace
+
+void OdometryConfig::validate() const {
+  features.validate();
+  require(std::isfinite(min_depth_m) && min_depth_m > 0.0, "min_depth_m", min_depth_m, "must be > 0");
+  require(std::isfinite(max_depth_m) && max_depth_m > min_depth_m, "max_depth_m", max_depth_m, "must be > min_depth_m");
+  require(std::isfinite(depth_edge_m) && depth_edge_m > 0.0, "depth_edge_m", depth_edge_m, "must be > 0");
+  require(init_min_features >= 4, "init_min_features", init_min_features, "must be >= 4");
+  require(min_inliers >= 4, "min_inliers", min_inliers, "must be >= 4 (PnP)");
+  require(weak_inliers >= min_inliers, "weak_inliers", weak_inliers, "must be >= min_inliers");
+  require(std::isfinite(search_radius_px) && search_radius_px > 0.0, "search_radius_px", search_radius_px,
+          "must be > 0");
+  require(max_descriptor_distance > 0 && max_descriptor_distance <= 256, "max_descriptor_distance",
+          max_descriptor_distance, "must be in 1..256");
+  require(ratio_test > 0.0 && ratio_test <= 1.0, "ratio_test", ratio_test, "must be in (0, 1]");
+  require(ransac_reprojection_px > 0.0, "ransac_reprojection_px", ransac_reprojection_px, "must be > 0");
+  require(ransac_iterations >= 1, "ransac_iterations", ransac_iterations, "must be >= 1");
+  require(ransac_confidence > 0.0 && ransac_confidence < 1.0, "ransac_confidence", ransac_confidence,
+          "must be in (0, 1)");
+  require(local_map_keyframes >= 1, "local_map_keyframes", local_map_keyframes, "must be >= 1");
+  require(keyframe_inlier_ratio > 0.0 && keyframe_inlier_ratio <= 1.0, "keyframe_inlier_ratio", keyframe_inlier_ratio,
+          "must be in (0, 1]");
+  require(keyframe_translation_m > 0.0, "keyframe_translation_m", keyframe_translation_m, "must be > 0");
+  require(keyframe_rotation_rad > 0.0, "keyframe_rotation_rad", keyframe_rotation_rad, "must be > 0");
+  require(landmark_max_misses >= 1, "landmark_max_misses", landmark_max_misses, "must be >= 1");
+}
+
+const char* toString(TrackingStatus status) {
+  switch (status) {
+    case TrackingStatus::kOk:
+      return "ok";
+    case TrackingStatus::kWeak:
+      return "weak";
+    case TrackingStatus::kLost:
+      return "lost";
+  }
+  return "?";
+}
+
+RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig& config, const Eigen::Isometry3d& X_WC0)
+    : camera_(camera),
+      config_(config),
+      detector_(config.features),
+      X_WC0_(X_WC0),
+      failed_at_(std::numeric_limits<double>::quiet_NaN()),
+      last_t_(-std::numeric_limits<double>::infinity()),
+      X_WC_(X_WC0) {
+  config_.validate();
+  require(camera.width_px > 0 && camera.height_px > 0, "camera.width_px", camera.width_px, "image size must be > 0");
+  require(std::isfinite(camera.fx) && camera.fx > 0.0 && std::isfinite(camera.fy) && camera.fy > 0.0, "camera.fx",
+          camera.fx, "focal lengths must be > 0");
+  require(std::isfinite(camera.cx) && std::isfinite(camera.cy), "camera.cx", camera.cx, "must be finite");
+}
+
+FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat& depth_m) {
+  if (!std::isfinite(t_s) || t_s <= last_t_) {
+    std::ostringstream msg;
+    msg << "frame time " << t_s << " s does not come after the previous frame's (" << last_t_ << " s)";
+    throw std::invalid_argument(msg.str());
+  }
+  if (image.empty() || (image.type() != CV_8UC1 && image.type() != CV_8UC3) || image.cols != camera_.width_px ||
+      image.rows != camera_.height_px) {
+    throw std::invalid_argument("image: expected 8-bit gray or BGR of " + std::to_string(camera_.width_px) + "x" +
+                                std::to_string(camera_.height_px));
+  }
+  if (depth_m.type() != CV_32FC1 || depth_m.cols != camera_.width_px || depth_m.rows != camera_.height_px) {
+    throw std::invalid_argument("depth: expected CV_32FC1 metres of " + std::to_string(camera_.width_px) + "x" +
+                                std::to_string(camera_.height_px));
+  }
+  last_t_ = t_s;
+  ++frame_;
+
+  FrameResult result;
+  result.t_s = t_s;
+  result.X_WC = X_WC_;
+  if (failed_ && !config_.reinitialise_after_lost) {
+    std::ostringstream msg;
+    msg << "lost at t = " << failed_at_ << " s (no re-initialisation)";
+    result.reason = msg.str();
+    history_.push_back(result);
+    return result;
+  }
+
+  // Features and their 3D points in the camera frame.
+  const Features f = detector_.detect(toGray(image));
+  result.features = static_cast<int>(f.keypoints.size());
+  std::vector<Eigen::Vector3d> p_C(f.keypoints.size());
+  std::vector<bool> valid(f.keypoints.size(), false);
+  for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
+    const int u = static_cast<int>(std::lround(f.keypoints[i].pt.x));
+    const int v = static_cast<int>(std::lround(f.keypoints[i].pt.y));
+    if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) continue;
+    const float z = depth_m.at<float>(v, u);
+    if (!std::isfinite(z) || z < config_.min_depth_m || z > config_.max_depth_m) continue;
+    // Depth discontinuity: a keypoint on an object's silhouette has no reliable depth.
+    float lo = z, hi = z;
+    bool holes = false;
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        const float d = depth_m.at<float>(v + dv, u + du);
+        if (!std::isfinite(d) || d <= 0.0f) holes = true;
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+      }
+    }
+    if (holes || hi - lo > config_.depth_edge_m * z) continue;
+    const double x = (f.keypoints[i].pt.x - camera_.cx) * z / camera_.fx;
+    const double y = (f.keypoints[i].pt.y - camera_.cy) * z / camera_.fy;
+    p_C[i] = Eigen::Vector3d(x, y, z);
+    valid[i] = true;
+    ++result.with_depth;
+  }
+
+  if (!initialised_) {
+    result = initialise(result, f, p_C, valid);
+    history_.push_back(result);
+    return result;
+  }
+
+  // Match the local map's landmarks to this frame's keypoints around their predicted pixels.
+  const Eigen::Isometry3d X_WC_pred = X_WC_ * velocity_;
+  const Eigen::Isometry3d X_CW_pred = X_WC_pred.inverse();
+  const double radius = config_.search_radius_px;
+  const KeypointGrid grid(f.keypoints, camera_.width_px, camera_.height_px, radius);
+  std::vector<std::array<std::uint64_t, 4>> bits(f.keypoints.size());
+  for (std::size_t i = 0; i < bits.size(); ++i) bits[i] = descriptorBits(f.descriptors, static_cast<int>(i));
+  const double r2 = radius * radius;
+  std::vector<int> best_landmark(f.keypoints.size(), -1);  // keypoint -> landmark
+  std::vector<int> best_distance(f.keypoints.size(), std::numeric_limits<int>::max());
+  std::vector<bool> expected(landmarks_.size(), false);
+  for (std::size_t l = 0; l < landmarks_.size(); ++l) {
+    const Eigen::Vector3d q = X_CW_pred * landmarks_[l].p_W;
+    if (q.z() < config_.min_depth_m) continue;
+    const double u = camera_.fx * q.x() / q.z() + camera_.cx;
+    const double v = camera_.fy * q.y() / q.z() + camera_.cy;
+    if (u < 0.0 || v < 0.0 || u > camera_.width_px - 1 || v > camera_.height_px - 1) continue;
+    expected[l] = true;
+    int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_i = -1;
+    grid.forEachNear(u, v, [&](int i) {
+      const double du = f.keypoints[static_cast<std::size_t>(i)].pt.x - u;
+      const double dv = f.keypoints[static_cast<std::size_t>(i)].pt.y - v;
+      if (du * du + dv * dv > r2) return;
+      const int d = hamming(landmarks_[l].descriptor, bits[static_cast<std::size_t>(i)]);
+      if (d < best) {
+        second = best;
+        best = d;
+        best_i = i;
+      } else if (d < second) {
+        second = d;
+      }
+    });
+    if (best_i < 0 || best > config_.max_descriptor_distance) continue;
+    if (second != std::numeric_limits<int>::max() && best >= config_.ratio_test * second) continue;
+    const std::size_t k = static_cast<std::size_t>(best_i);
+    if (best < best_distance[k]) {  // one landmark per keypoint: the closest in descriptor space
+      best_distance[k] = best;
+      best_landmark[k] = static_cast<int>(l);
+    }
+  }
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> pixels;
+  std::vector<int> match_keypoint;
+  for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
+    if (best_landmark[i] < 0) continue;
+    const Eigen::Vector3d& p = landmarks_[static_cast<std::size_t>(best_landmark[i])].p_W;
+    object.emplace_back(p.x(), p.y(), p.z());
+    pixels.emplace_back(f.keypoints[i].pt.x, f.keypoints[i].pt.y);
+    match_keypoint.push_back(static_cast<int>(i));
+  }
+  result.matches = static_cast<int>(object.size());
+
+  auto lose = [&](const std::string& why) {
+    result.status = TrackingStatus::kLost;
+    result.reason = why;
+    result.X_WC = X_WC_;
+    if (!failed_) {
+      failed_ = true;
+      failed_at_ = t_s;
+    }
+    if (config_.reinitialise_after_lost) {
+      initialised_ = false;
+      X_WC0_ = X_WC_;  // carry on from the last good pose
+      landmarks_.clear();
+      keyframes_.clear();
+      velocity_.setIdentity();
+    }
+    history_.push_back(result);
+    return result;
+  };
+  if (result.matches < config_.min_inliers) {
+    return lose(std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
+  }
+
+  // Pose: PnP RANSAC from the prediction, Levenberg-Marquardt on the inliers, inliers again.
+  const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
+  cv::Mat rvec, tvec;
+  {
+    cv::Mat R;
+    cv::eigen2cv(Eigen::Matrix3d(X_CW_pred.linear()), R);
+    cv::Rodrigues(R, rvec);
+    cv::eigen2cv(Eigen::Vector3d(X_CW_pred.translation()), tvec);
+  }
+  std::vector<int> inliers;
+  const bool ok = cv::solvePnPRansac(object, pixels, K, cv::noArray(), rvec, tvec, true, config_.ransac_iterations,
+                                     static_cast<float>(config_.ransac_reprojection_px), config_.ransac_confidence,
+                                     inliers, cv::SOLVEPNP_EPNP);
+  if (!ok || static_cast<int>(inliers.size()) < config_.min_inliers) {
+    result.inliers = static_cast<int>(inliers.size());
+    return lose(std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
+  }
+  std::vector<cv::Point3d> obj_in;
+  std::vector<cv::Point2d> pix_in;
+  for (int i : inliers) {
+    obj_in.push_back(object[static_cast<std::size_t>(i)]);
+    pix_in.push_back(pixels[static_cast<std::size_t>(i)]);
+  }
+  cv::solvePnPRefineLM(obj_in, pix_in, K, cv::noArray(), rvec, tvec);
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d R_CW;
+  Eigen::Vector3d t_CW;
+  cv::cv2eigen(R, R_CW);
+  cv::cv2eigen(tvec, t_CW);
+  Eigen::Isometry3d X_CW = Eigen::Isometry3d::Identity();
+  X_CW.linear() = R_CW;
+  X_CW.translation() = t_CW;
+  if (!X_CW.matrix().allFinite()) return lose("PnP gave a non-finite pose");
+
+  // Inliers of the refined pose.
+  std::vector<bool> is_inlier(object.size(), false);
+  const double thr2 = config_.ransac_reprojection_px * config_.ransac_reprojection_px;
+  int n_in = 0;
+  for (std::size_t m = 0; m < object.size(); ++m) {
+    const Eigen::Vector3d q = X_CW * Eigen::Vector3d(object[m].x, object[m].y, object[m].z);
+    if (q.z() <= 0.0) continue;
+    const double du = camera_.fx * q.x() / q.z() + camera_.cx - pixels[m].x;
+    const double dv = camera_.fy * q.y() / q.z() + camera_.cy - pixels[m].y;
+    if (du * du + dv * dv <= thr2) {
+      is_inlier[m] = true;
+      ++n_in;
+    }
+  }
+  result.inliers = n_in;
+  if (n_in < config_.min_inliers) {
+    return lose(std::to_string(n_in) + " inliers < " + std::to_string(config_.min_inliers));
+  }
+
+  const Eigen::Isometry3d X_WC = X_CW.inverse();
+  velocity_ = X_WC_.inverse() * X_WC;
+  X_WC_ = X_WC;
+  result.X_WC = X_WC;
+  result.status = n_in < config_.weak_inliers ? TrackingStatus::kWeak : TrackingStatus::kOk;
+
+  // Landmark bookkeeping: matched inliers are fresh, expected but unmatched ones age.
+  std::vector<bool> seen(landmarks_.size(), false);
+  std::vector<int> matched_landmark(f.keypoints.size(), -1);
+  for (std::size_t m = 0; m < object.size(); ++m) {
+    if (!is_inlier[m]) continue;
+    const int k = match_keypoint[m];
+    const int l = best_landmark[static_cast<std::size_t>(k)];
+    seen[static_cast<std::size_t>(l)] = true;
+    matched_landmark[static_cast<std::size_t>(k)] = l;
+  }
+  for (std::size_t l = 0; l < landmarks_.size(); ++l) {
+    if (seen[l]) {
+      landmarks_[l].misses = 0;
+      landmarks_[l].last_seen = frame_;
+    } else if (expected[l]) {
+      ++landmarks_[l].misses;
+    }
+  }
+
+  // Keyframe: tracking thins out, or the camera moved or turned enough since the last one.
+  const Keyframe& last = keyframes_.back();
+  const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC;
+  const bool need_keyframe = n_in < config_.keyframe_inlier_ratio * last.tracked ||
+                             rel.translation().norm() > config_.keyframe_translation_m ||
+                             rotationAngle(rel.linear()) > config_.keyframe_rotation_rad;
+  if (need_keyframe) {
+    addKeyframe(X_WC, f, p_C, valid, matched_landmark, n_in);
+    result.keyframe = true;
+  }
+  // Cull landmarks that keep failing to match where they should be seen (after the keyframe
+  // step, which indexes landmarks_ through matched_landmark).
+  landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
+                                  [&](const Landmark& lm) { return lm.misses > config_.landmark_max_misses; }),
+                   landmarks_.end());
+  history_.push_back(result);
+  return result;
+}
+
+FrameResult RgbdOdometry::initialise(FrameResult result, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
+                                     const std::vector<bool>& valid) {
+  if (result.with_depth < config_.init_min_features) {
+    result.status = TrackingStatus::kLost;
+    result.reason = std::to_string(result.with_depth) + " features with depth < " +
+                    std::to_string(config_.init_min_features) + " to initialise";
+    if (!failed_) {
+      failed_ = true;
+      failed_at_ = result.t_s;
+    }
+    return result;
+  }
+  initialised_ = true;
+  result.reinitialised = !history_.empty();
+  X_WC_ = X_WC0_;
+  velocity_.setIdentity();
+  landmarks_.clear();
+  keyframes_.clear();
+  addKeyframe(X_WC_, f, p_C, valid, std::vector<int>(f.keypoints.size(), -1), 0);
+  result.X_WC = X_WC_;
+  result.status = TrackingStatus::kOk;
+  result.inliers = result.with_depth;
+  result.keyframe = true;
+  return result;
+}
+
+void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Features& f,
+                               const std::vector<Eigen::Vector3d>& p_C, const std::vector<bool>& valid,
+                               const std::vector<int>& matched_landmark, int tracked) {
+  Keyframe kf;
+  kf.id = next_keyframe_id_++;
+  kf.X_WC = X_WC;
+  int created = 0;
+  for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
+    if (!valid[i] || matched_landmark[i] >= 0) continue;  // tracked keypoints already have a landmark
+    Landmark lm;
+    lm.p_W = X_WC * p_C[i];
+    lm.descriptor = descriptorBits(f.descriptors, static_cast<int>(i));
+    lm.keyframe = kf.id;
+    lm.last_seen = frame_;
+    landmarks_.push_back(std::move(lm));
+    ++created;
+  }
+  kf.tracked = tracked + created;
+  keyframes_.push_back(kf);
+  // The local map: landmarks of the last local_map_keyframes keyframes. Those of the keyframe
+  // leaving it go too, unless they were matched in this frame (they then belong to the newest).
+  while (static_cast<int>(keyframes_.size()) > config_.local_map_keyframes) {
+    const int gone = keyframes_.front().id;
+    keyframes_.pop_front();
+    for (Landmark& lm : landmarks_) {
+      if (lm.keyframe == gone && lm.last_seen == frame_) lm.keyframe = kf.id;
+    }
+    landmarks_.erase(
+        std::remove_if(landmarks_.begin(), landmarks_.end(), [&](const Landmark& lm) { return lm.keyframe == gone; }),
+        landmarks_.end());
+  }
+}
+
+}  // namespace tgnav::vo

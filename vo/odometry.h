@@ -1,0 +1,125 @@
+#pragma once
+// RGB-D feature visual odometry: ORB features (grid-spread) with depth, tracked against a local
+// map of the recent keyframes' 3D landmarks by descriptor matching inside a motion-model window,
+// pose by PnP RANSAC refined on the inliers (Levenberg-Marquardt on reprojection error),
+// keyframes by inlier ratio and motion, landmarks culled when they stop being matched.
+//
+// Tracking status per frame, with the counts behind it: ok, weak (few inliers), lost (inliers
+// below min_inliers, ORB-SLAM2's 30 by default). The paper counts a run as failed at the first
+// loss: after it, failed() stays true; with reinitialise_after_lost the odometry starts again
+// from the next frame with enough features (its pose continues from the last good one).
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "vo/features.h"
+
+namespace tgnav::vo {
+
+struct CameraIntrinsics {
+  int width_px = 0;
+  int height_px = 0;
+  double fx = 0.0;
+  double fy = 0.0;
+  double cx = 0.0;
+  double cy = 0.0;
+};
+
+struct OdometryConfig {
+  FeatureConfig features;
+  double min_depth_m = 0.2;  // features with depth outside this range have no 3D point
+  double max_depth_m = 8.0;
+  double depth_edge_m = 0.05;        // ... nor those on a depth discontinuity (3x3 spread above
+                                     // this times the depth)
+  int init_min_features = 100;       // features with depth needed to start (or restart)
+  int min_inliers = 30;              // below: lost (ORB-SLAM2: 30 local-map inliers)
+  int weak_inliers = 60;             // below: weak
+  double search_radius_px = 24.0;    // matching window around the motion-model prediction
+  int max_descriptor_distance = 64;  // Hamming, of 256 bits
+  double ratio_test = 0.8;           // best / second best within the window
+  double ransac_reprojection_px = 2.0;
+  int ransac_iterations = 200;
+  double ransac_confidence = 0.995;
+  int local_map_keyframes = 5;          // keyframes whose landmarks form the local map
+  double keyframe_inlier_ratio = 0.6;   // new keyframe when tracked landmarks fall below this
+                                        // fraction of the last keyframe's
+  double keyframe_translation_m = 0.4;  // ... or the camera moved this far
+  double keyframe_rotation_rad = 0.35;  // ... or turned this much
+  int landmark_max_misses = 10;         // cull a landmark not matched in this many frames it was expected in
+  bool reinitialise_after_lost = false;
+
+  void validate() const;  // std::invalid_argument naming the field and value
+};
+
+enum class TrackingStatus { kOk, kWeak, kLost };
+const char* toString(TrackingStatus status);
+
+struct FrameResult {
+  double t_s = 0.0;
+  TrackingStatus status = TrackingStatus::kLost;
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();  // estimate (last good one when lost)
+  int features = 0;                                        // ORB keypoints detected
+  int with_depth = 0;                                      // ... of which with a valid 3D point
+  int matches = 0;                                         // putative matches to the local map
+  int inliers = 0;                                         // PnP RANSAC inliers after refinement
+  bool keyframe = false;                                   // this frame became a keyframe
+  bool reinitialised = false;
+  std::string reason;  // for lost frames: why (e.g. "12 inliers < 30")
+};
+
+class RgbdOdometry {
+ public:
+  // `X_WC0`: the pose the first frame is given (e.g. ground truth's, or identity).
+  RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig& config,
+               const Eigen::Isometry3d& X_WC0 = Eigen::Isometry3d::Identity());
+
+  // `image`: CV_8UC1 or CV_8UC3 (BGR); `depth_m`: CV_32FC1 metres along the optical axis, 0 or
+  // non-finite = invalid; both of the camera's size (std::invalid_argument otherwise). Frames
+  // must come in increasing time.
+  FrameResult track(double t_s, const cv::Mat& image, const cv::Mat& depth_m);
+
+  bool failed() const { return failed_; }         // lost at least once
+  double failedAt() const { return failed_at_; }  // time of the first loss (NaN if none)
+  const std::vector<FrameResult>& history() const { return history_; }
+
+ private:
+  struct Landmark {
+    Eigen::Vector3d p_W;
+    std::array<std::uint64_t, 4> descriptor{};  // the 256-bit ORB descriptor
+    int misses = 0;
+    int keyframe = 0;    // id of the keyframe it belongs to (created it, or last kept it)
+    long last_seen = 0;  // frame number it was created or last matched in
+  };
+  struct Keyframe {
+    int id = 0;
+    Eigen::Isometry3d X_WC;
+    int tracked = 0;  // landmarks it tracked or created
+  };
+
+  FrameResult initialise(FrameResult result, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
+                         const std::vector<bool>& valid);
+  void addKeyframe(const Eigen::Isometry3d& X_WC, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
+                   const std::vector<bool>& valid, const std::vector<int>& matched_landmark, int tracked);
+
+  CameraIntrinsics camera_;
+  OdometryConfig config_;
+  FeatureDetector detector_;
+  Eigen::Isometry3d X_WC0_;
+  bool initialised_ = false;
+  bool failed_ = false;
+  double failed_at_;
+  double last_t_;
+  Eigen::Isometry3d X_WC_ = Eigen::Isometry3d::Identity();      // last estimate
+  Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // X_{C_prev C} of the last step
+  std::vector<Landmark> landmarks_;
+  std::deque<Keyframe> keyframes_;
+  int next_keyframe_id_ = 0;
+  long frame_ = 0;  // frames tracked
+  std::vector<FrameResult> history_;
+};
+
+}  // namespace tgnav::vo
