@@ -11,10 +11,10 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 build="$root/build-bench"
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release -DTGNAV_BUILD_TESTS=OFF \
   -DTGNAV_BUILD_BENCHMARKS=ON >/dev/null
-cmake --build "$build" -j"$(nproc)" --target sim_benchmark map_benchmark planner_benchmark tgnav >&2
+cmake --build "$build" -j"$(nproc)" --target sim_benchmark map_benchmark planner_benchmark vo_benchmark tgnav >&2
 out="$root/results/bench"
 mkdir -p "$out"
-for b in sim map planner; do
+for b in sim map planner vo; do
   "$build/tests/bench/${b}_benchmark" --benchmark_out="$out/$b.json.tmp" \
     --benchmark_out_format=json --benchmark_min_time=1 "$@" >&2
   mv "$out/$b.json.tmp" "$out/$b.json"
@@ -71,7 +71,7 @@ for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "b
         for key, value in b.items():
             if key in ("ms_per_frame", "us_per_step", "us_per_cycle", "real_time_factor", "queries_per_s",
                        "landmarks_per_query", "ms_per_plan", "classes", "ms_per_trajectory",
-                       "path_length_m", "optimised"):
+                       "path_length_m", "optimised", "ate_percent", "lost_frames"):
                 rows.append({"benchmark": b["name"], "figure": key, "value": value})
 meta = {"git_sha": sha, "host": socket.gethostname(), "cpus": os.cpu_count(),
         "date": datetime.datetime.now().isoformat(timespec="seconds")}
