@@ -11,9 +11,10 @@ void addRenderCommand(CLI::App& app);
 void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
+void addVoCommand(CLI::App& app);
 
 // Parses "a,b,c" into exactly `count` finite numbers; InputError naming `option` otherwise.
-std::vector<double> parseNumbers(const std::string& text, std::size_t count,
-                                 const std::string& option, const std::string& form);
+std::vector<double> parseNumbers(const std::string& text, std::size_t count, const std::string& option,
+                                 const std::string& form);
 
 }  // namespace tgnav::cli

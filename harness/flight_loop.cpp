@@ -27,8 +27,8 @@ int stepsPer(double physics_hz, double loop_hz, const char* name) {
   const int n = static_cast<int>(std::lround(ratio));
   if (n < 1 || std::abs(ratio - n) > 1e-6) {
     std::ostringstream msg;
-    msg << "controller " << name << " = " << loop_hz << " Hz does not divide the physics rate of "
-        << physics_hz << " Hz";
+    msg << "controller " << name << " = " << loop_hz << " Hz does not divide the physics rate of " << physics_hz
+        << " Hz";
     throw InputError(msg.str());
   }
   return n;
@@ -79,8 +79,8 @@ bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) {
   return !checkDiverged();
 }
 
-FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory,
-                           const FlightConfig& config) {
+FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory, const FlightConfig& config,
+                           const StepHook& after_step) {
   config.validate();
   loop.setDivergenceLimits(config.diverged_tilt_rad, config.diverged_speed_m_s);
   FlightResult result;
@@ -120,6 +120,7 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
       result.reason = loop.divergence();
       break;
     }
+    if (after_step) after_step(loop);
   }
   return result;
 }

@@ -4,6 +4,7 @@
 // State comes from ground truth (the paper flew its vehicle on motion capture).
 #include <mujoco/mujoco.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -14,10 +15,10 @@
 namespace tgnav::harness {
 
 struct FlightConfig {
-  double takeoff_speed_m_s = 1.0;  // peak climb speed from the ground to the first setpoint
-  double settle_s = 1.0;           // hover at the first setpoint before the trajectory starts
-  double hold_s = 2.0;             // keep holding the last setpoint after the trajectory ends
-  double max_start_offset_m = 0.5; // first setpoint vs. start pose, horizontally
+  double takeoff_speed_m_s = 1.0;       // peak climb speed from the ground to the first setpoint
+  double settle_s = 1.0;                // hover at the first setpoint before the trajectory starts
+  double hold_s = 2.0;                  // keep holding the last setpoint after the trajectory ends
+  double max_start_offset_m = 0.5;      // first setpoint vs. start pose, horizontally
   double diverged_tilt_rad = M_PI / 2;  // beyond these the flight stops as diverged
   double diverged_speed_m_s = 20.0;
 
@@ -35,6 +36,7 @@ class FlightLoop {
   bool step(const control::TrajectorySetpoint& setpoint);
   control::VehicleState state() const { return vehicleState(d_, ids_); }
   double time() const { return d_->time; }
+  long steps() const { return steps_; }  // physics steps taken by this loop
   bool positionUpdateDue() const { return steps_ % per_position_ == 0; }
   const std::string& divergence() const { return divergence_; }
   const control::VehicleParams& vehicle() const { return vehicle_; }
@@ -69,15 +71,21 @@ struct FlightSample {
 
 struct FlightResult {
   FlightStatus status = FlightStatus::kCompleted;
-  std::string reason;          // why it diverged
+  std::string reason;               // why it diverged
   double trajectory_start_s = 0.0;  // sim time at which the trajectory's first setpoint applied
   std::vector<FlightSample> log;    // at the position-loop rate
 };
 
+// Called after every physics step that did not diverge (e.g. to render the onboard camera).
+// It must leave the state the next step reads (qpos, qvel, act, ctrl) alone; recomputing
+// kinematics (mj_kinematics, mj_camlight) is fine, mj_step recomputes them anyway.
+using StepHook = std::function<void(const FlightLoop& loop)>;
+
 // Takes off from the vehicle's current (landed) pose to the trajectory's first setpoint,
-// settles, flies the trajectory and holds its end.
-FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory,
-                           const FlightConfig& config);
+// settles, flies the trajectory and holds its end. `after_step`, when set, runs after each
+// physics step; the flight is the same with or without it.
+FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory, const FlightConfig& config,
+                           const StepHook& after_step = nullptr);
 
 struct TrackingSummary {
   double duration_s = 0.0;

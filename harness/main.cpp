@@ -9,8 +9,8 @@
 
 namespace tgnav::cli {
 
-std::vector<double> parseNumbers(const std::string& text, std::size_t count,
-                                 const std::string& option, const std::string& form) {
+std::vector<double> parseNumbers(const std::string& text, std::size_t count, const std::string& option,
+                                 const std::string& form) {
   std::vector<double> values;
   std::stringstream ss(text);
   std::string item;
@@ -54,6 +54,7 @@ int main(int argc, char** argv) {
   tgnav::cli::addFlyCommand(app);
   tgnav::cli::addMapCommand(app);
   tgnav::cli::addPlanCommand(app);
+  tgnav::cli::addVoCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

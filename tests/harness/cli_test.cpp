@@ -4,11 +4,15 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "harness/tum_sequence.h"
 #include "test_util.h"
 
 namespace tgnav {
@@ -305,6 +309,204 @@ TEST(CliPlanScenario, BadInputIsOneLineExit2AndWritesNothing) {
     EXPECT_NE(run.output.find(c.expect), std::string::npos) << run.output;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
   }
+}
+
+// --- tgnav fly --record and tgnav vo -------------------------------------------------------
+
+int dataRows(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  int rows = 0;
+  for (std::string line; std::getline(in, line);) rows += (!line.empty() && line[0] != '#');
+  return rows;
+}
+
+int filesIn(const std::filesystem::path& dir) {
+  return static_cast<int>(
+      std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+
+nlohmann::json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+TEST(CliRecord, RecordsATumSequenceThatVoRuns) {
+  const auto dir = test::tempDir();
+  const auto seq = dir / "seq";
+  const CmdResult run = tgnav("fly --scene " + smoke() + " --trajectory " + pillarCsv() + " --out " +
+                              (dir / "flight").string() + " --record " + seq.string() + " --width 160 --height 120");
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("recorded"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(seq.string() + ".partial"));
+  // 20 Hz over the whole flight, from t = 0 on the ground.
+  const double sim_time_s = readJson(dir / "flight" / "tracking.json")["sim_time_s"].get<double>();
+  const int frames = dataRows(seq / "rgb.txt");
+  EXPECT_EQ(frames, static_cast<int>(std::floor(sim_time_s * 20.0 + 1e-6)) + 1) << sim_time_s;
+  EXPECT_EQ(dataRows(seq / "depth.txt"), frames);
+  EXPECT_EQ(dataRows(seq / "groundtruth.txt"), frames);
+  EXPECT_EQ(filesIn(seq / "rgb"), frames);
+  EXPECT_EQ(filesIn(seq / "depth"), frames);
+  EXPECT_TRUE(std::filesystem::is_regular_file(seq / "intrinsics.yaml"));
+  const harness::Sequence loaded = harness::loadSequence(seq);
+  ASSERT_EQ(static_cast<int>(loaded.frames.size()), frames);
+  ASSERT_TRUE(loaded.intrinsics.has_value());
+  EXPECT_EQ(loaded.intrinsics->width_px, 160);
+  EXPECT_EQ(loaded.intrinsics->height_px, 120);
+  const harness::SequenceImages mid = harness::loadFrame(loaded, frames / 2);
+  EXPECT_EQ(mid.bgr.type(), CV_8UC3);
+  EXPECT_GT(cv::countNonZero(mid.depth_m), 160 * 120 / 2) << "mid-flight, the camera sees the scene";
+  // The camera's pose in mid-flight is the vehicle's, about 1 m up and facing +x (optical z).
+  const Eigen::Isometry3d& X_WC = loaded.groundtruth[frames / 2].X_WC;
+  EXPECT_NEAR(X_WC.translation().z(), 1.0, 0.1);
+  EXPECT_GT((X_WC.linear() * Eigen::Vector3d::UnitZ()).x(), 0.9);
+
+  const auto out = dir / "vo";
+  const CmdResult vo = tgnav("vo --sequence " + seq.string() + " --out " + out.string());
+  ASSERT_EQ(vo.rc, 0) << vo.output;
+  EXPECT_EQ(lines(vo.output), 1) << vo.output;
+  for (const char* f : {"est.tum", "status.csv", "summary.json"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / f)) << f;
+  }
+  EXPECT_EQ(dataRows(out / "status.csv"), frames + 1) << "a header and one row per frame";
+  std::ifstream status(out / "status.csv");
+  std::string header;
+  std::getline(status, header);
+  EXPECT_EQ(header, "t,status,features,with_depth,matches,inliers,keyframe,reason");
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["frames"].get<int>(), frames);
+  EXPECT_EQ(summary["ok"].get<int>() + summary["weak"].get<int>() + summary["lost"].get<int>(), frames);
+  EXPECT_EQ(dataRows(out / "est.tum"), summary["ok"].get<int>() + summary["weak"].get<int>());
+  EXPECT_EQ(summary["groundtruth"], true);
+  EXPECT_EQ(summary["initial_pose"], "groundtruth");
+  for (const char* key : {"failed_at_s", "ate_rmse_aligned_m", "ate_rmse_anchored_m", "rpe_trans_rmse_percent",
+                          "distance_travelled_m", "goal_error_m", "ms_per_frame"}) {
+    EXPECT_TRUE(summary.contains(key)) << key;
+  }
+  // Never overwritten.
+  const CmdResult again = tgnav("vo --sequence " + seq.string() + " --out " + out.string());
+  EXPECT_EQ(again.rc, 2);
+  EXPECT_EQ(lines(again.output), 1) << again.output;
+  EXPECT_NE(again.output.find("--out: " + out.string() + " already exists"), std::string::npos) << again.output;
+}
+
+TEST(CliRecord, BadRecordingOptionsAreOneLineExit2AndWriteNothing) {
+  const auto dir = test::tempDir();
+  const auto taken = dir / "taken";
+  std::filesystem::create_directories(taken);
+  test::writeFile(taken / "keep.txt", "keep me");
+  const auto out = dir / "flight";
+  const std::string fly = "fly --scene " + smoke() + " --trajectory " + pillarCsv() + " --out " + out.string();
+  const struct {
+    std::string args;
+    std::string expect;
+  } cases[] = {
+      {" --record " + taken.string(), "--record: " + taken.string() + " already exists"},
+      {" --record " + (dir / "seq").string() + " --record-rate 30", "--record-rate: 30 Hz does not divide"},
+      {" --record " + (dir / "seq").string() + " --record-rate 0", "--record-rate: 0 Hz"},
+      {" --record " + (dir / "seq").string() + " --width 8", "width_px = 8"},
+      {" --record " + out.string(), "is also --out"},
+      {" --width 160", "--width requires --record"},
+  };
+  for (const auto& c : cases) {
+    const CmdResult run = tgnav(fly + c.args);
+    EXPECT_EQ(run.rc, 2) << c.args << ": " << run.output;
+    EXPECT_EQ(lines(run.output), 1) << run.output;
+    EXPECT_NE(run.output.find(c.expect), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
+    EXPECT_FALSE(std::filesystem::exists(dir / "seq")) << c.args;
+    EXPECT_FALSE(std::filesystem::exists(dir / "seq.partial")) << c.args;
+  }
+  EXPECT_EQ(filesIn(taken), 1);
+}
+
+// A small synthetic sequence: noise images, flat depth, ground truth along x.
+std::filesystem::path smallSequence(const std::filesystem::path& dir, int frames = 4) {
+  harness::SequenceWriter writer(dir, vo::CameraIntrinsics{64, 48, 50.0, 50.0, 31.5, 23.5});
+  cv::RNG rng(3);
+  for (int i = 0; i < frames; ++i) {
+    cv::Mat bgr(48, 64, CV_8UC3);
+    rng.fill(bgr, cv::RNG::UNIFORM, 0, 256);
+    Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+    X_WC.translation().x() = 0.01 * i;
+    writer.add(0.05 * i, bgr, cv::Mat(48, 64, CV_32FC1, cv::Scalar(2.0f)), X_WC);
+  }
+  writer.finish();
+  return dir;
+}
+
+TEST(CliVo, BadSequencesAreOneLineExit2AndWriteNothing) {
+  const auto dir = test::tempDir();
+  const auto out = dir / "out";
+  const struct {
+    std::string name;
+    std::function<void(const std::filesystem::path&)> spoil;
+    std::string expect;  // after the sequence's path
+    std::string extra_args;
+  } cases[] = {
+      {"missing", [](const std::filesystem::path& s) { std::filesystem::remove_all(s); },
+       ": no such sequence directory", ""},
+      {"empty_rgb", [](const std::filesystem::path& s) { test::writeFile(s / "rgb.txt", "# no frames\n"); },
+       "/rgb.txt: lists no images", ""},
+      {"non_monotonic",
+       [](const std::filesystem::path& s) {
+         test::writeFile(s / "depth.txt", "0.0 depth/0.000000.png\n0.1 depth/0.100000.png\n0.05 depth/0.050000.png\n");
+       },
+       "/depth.txt:3: timestamp 0.05 does not increase", ""},
+      {"missing_depth", [](const std::filesystem::path& s) { std::filesystem::remove(s / "depth/0.100000.png"); },
+       "/depth/0.100000.png (depth.txt:6): no such image file", ""},
+      {"corrupt_depth", [](const std::filesystem::path& s) { test::writeFile(s / "depth/0.150000.png", "junk"); },
+       "/depth/0.150000.png (depth.txt:7): cannot read image", ""},
+      {"no_intrinsics", [](const std::filesystem::path& s) { std::filesystem::remove(s / "intrinsics.yaml"); },
+       "/intrinsics.yaml: missing; give the camera as --intrinsics fx,fy,cx,cy", ""},
+      {"bad_intrinsics_option", [](const std::filesystem::path&) {}, "", " --intrinsics 50,50,31.5"},
+  };
+  for (const auto& c : cases) {
+    const auto seq = smallSequence(dir / c.name);
+    c.spoil(seq);
+    const CmdResult run = tgnav("vo --sequence " + seq.string() + " --out " + out.string() + c.extra_args);
+    EXPECT_EQ(run.rc, 2) << c.name << ": " << run.output;
+    EXPECT_EQ(lines(run.output), 1) << run.output;
+    EXPECT_NE(run.output.find(c.extra_args.empty() ? seq.string() + c.expect : "--intrinsics: '50,50,31.5'"),
+              std::string::npos)
+        << c.name << ": " << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.name;
+    EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial")) << c.name;
+  }
+}
+
+TEST(CliVo, ConfigErrorsNameTheFileAndKey) {
+  const auto dir = test::tempDir();
+  const auto seq = smallSequence(dir / "seq");
+  const auto yaml = test::writeFile(dir / "vo.yaml", "min_inliers: 20\nfeatures:\n  max_featres: 500\n");
+  const CmdResult run =
+      tgnav("vo --sequence " + seq.string() + " --out " + (dir / "out").string() + " --config " + yaml.string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(yaml.string() + ":3: unknown key 'features.max_featres'"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+TEST(CliVo, SequenceWithoutGroundtruthTakesIntrinsicsFromTheCommandLine) {
+  const auto dir = test::tempDir();
+  const auto seq = smallSequence(dir / "seq");
+  std::filesystem::remove(seq / "groundtruth.txt");
+  std::filesystem::remove(seq / "intrinsics.yaml");
+  const auto out = dir / "out";
+  const CmdResult run = tgnav("vo --sequence " + seq.string() + " --out " + out.string() +
+                              " --intrinsics 50,50,31.5,23.5 --reinitialise");
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("no ground truth"), std::string::npos) << run.output;
+  const nlohmann::json summary = readJson(out / "summary.json");
+  EXPECT_EQ(summary["frames"], 4);
+  EXPECT_EQ(summary["groundtruth"], false);
+  EXPECT_EQ(summary["initial_pose"], "identity");
+  EXPECT_EQ(summary["reinitialise_after_lost"], true);
+  EXPECT_EQ(summary["odometry_config"]["reinitialise_after_lost"], true);
+  EXPECT_EQ(summary["intrinsics"]["width"], 64);
+  EXPECT_EQ(summary["intrinsics"]["source"], "--intrinsics");
+  EXPECT_TRUE(summary["ate_rmse_aligned_m"].is_null());
+  EXPECT_TRUE(summary["goal_error_m"].is_null());
+  EXPECT_EQ(dataRows(out / "status.csv"), 5);
 }
 
 }  // namespace
