@@ -14,6 +14,7 @@
 #include <string>
 
 #include "harness/egl_context.h"
+#include "vo/camera_intrinsics.h"
 
 namespace tgnav::harness {
 
@@ -21,25 +22,19 @@ struct CameraConfig {
   std::string name = "front";  // MJCF camera name
   int width_px = 640;
   int height_px = 480;
-  double near_clip_m = 0.05;   // OpenGL clipping planes
+  double near_clip_m = 0.05;  // OpenGL clipping planes
   double far_clip_m = 40.0;
-  double min_depth_m = 0.1;    // depth outside [min, max] is reported invalid (0)
+  double min_depth_m = 0.1;  // depth outside [min, max] is reported invalid (0)
   double max_depth_m = 10.0;
-  double rgb_noise_sigma = 0.0;              // Gaussian pixel noise, 8-bit intensity units
-  double depth_noise_sigma_per_m2 = 0.0;     // depth noise sigma = k z^2 (structured light)
+  double rgb_noise_sigma = 0.0;           // Gaussian pixel noise, 8-bit intensity units
+  double depth_noise_sigma_per_m2 = 0.0;  // depth noise sigma = k z^2 (structured light)
 
   // Throws std::invalid_argument naming the field and value.
   void validate() const;
 };
 
-struct Intrinsics {
-  int width_px = 0;
-  int height_px = 0;
-  double fx = 0.0;
-  double fy = 0.0;
-  double cx = 0.0;
-  double cy = 0.0;
-};
+// The camera's intrinsics, in the form the VO takes them.
+using Intrinsics = vo::CameraIntrinsics;
 
 struct RgbdFrame {
   double t_s = 0.0;

@@ -177,9 +177,7 @@ void runFly(const FlyOptions& opt) {
     view = harness::makeData(model.get());
     gl = std::make_unique<harness::EglContext>();
     camera = std::make_unique<harness::Camera>(model.get(), *gl, record.camera, opt.seed);
-    const harness::Intrinsics& k = camera->intrinsics();
-    writer = std::make_unique<harness::SequenceWriter>(
-        opt.record, vo::CameraIntrinsics{k.width_px, k.height_px, k.fx, k.fy, k.cx, k.cy});
+    writer = std::make_unique<harness::SequenceWriter>(opt.record, camera->intrinsics());
     after_step = [&](const harness::FlightLoop& l) {
       if (l.steps() % record.steps_per_frame == 0) capture();
     };

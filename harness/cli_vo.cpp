@@ -12,10 +12,10 @@
 #include <system_error>
 
 #include "harness/cli.h"
+#include "harness/config_io.h"
 #include "harness/errors.h"
 #include "harness/output.h"
 #include "harness/tum_sequence.h"
-#include "harness/yaml_util.h"
 #include "vo/metrics.h"
 #include "vo/odometry.h"
 #include "vo/tum.h"
@@ -36,51 +36,6 @@ struct VoOptions {
   std::string intrinsics;
   bool reinitialise = false;
 };
-
-// OdometryConfig from YAML: keys are the fields of vo::OdometryConfig (features: the fields of
-// vo::FeatureConfig), all optional, unknown keys are errors.
-vo::OdometryConfig loadOdometryConfig(const fs::path& yaml) {
-  const harness::YamlDoc doc = harness::YamlDoc::load(yaml);
-  vo::OdometryConfig c;
-  harness::FieldReader(doc, doc.root(), "")
-      .section("features",
-               [&](harness::FieldReader r) {
-                 vo::FeatureConfig& f = c.features;
-                 r.read("max_features", f.max_features)
-                     .read("grid_cols", f.grid_cols)
-                     .read("grid_rows", f.grid_rows)
-                     .read("fast_threshold", f.fast_threshold)
-                     .read("scale_factor", f.scale_factor)
-                     .read("pyramid_levels", f.pyramid_levels)
-                     .read("edge_threshold_px", f.edge_threshold_px)
-                     .finish();
-               })
-      .read("min_depth_m", c.min_depth_m)
-      .read("max_depth_m", c.max_depth_m)
-      .read("depth_edge_m", c.depth_edge_m)
-      .read("init_min_features", c.init_min_features)
-      .read("min_inliers", c.min_inliers)
-      .read("weak_inliers", c.weak_inliers)
-      .read("search_radius_px", c.search_radius_px)
-      .read("max_descriptor_distance", c.max_descriptor_distance)
-      .read("ratio_test", c.ratio_test)
-      .read("ransac_reprojection_px", c.ransac_reprojection_px)
-      .read("ransac_iterations", c.ransac_iterations)
-      .read("ransac_confidence", c.ransac_confidence)
-      .read("local_map_keyframes", c.local_map_keyframes)
-      .read("keyframe_inlier_ratio", c.keyframe_inlier_ratio)
-      .read("keyframe_translation_m", c.keyframe_translation_m)
-      .read("keyframe_rotation_rad", c.keyframe_rotation_rad)
-      .read("landmark_max_misses", c.landmark_max_misses)
-      .read("reinitialise_after_lost", c.reinitialise_after_lost)
-      .finish();
-  try {
-    c.validate();
-  } catch (const std::invalid_argument& e) {
-    throw InputError(yaml.string() + ": " + e.what());
-  }
-  return c;
-}
 
 // The odometry settings in force, in loadOdometryConfig's keys.
 nlohmann::ordered_json resolvedConfig(const vo::OdometryConfig& c) {
@@ -156,7 +111,7 @@ void runVo(const VoOptions& opt) {
     throw InputError("--out: " + opt.out + " already exists; tgnav vo writes a new directory and never overwrites");
   }
   vo::OdometryConfig config;
-  if (!opt.config.empty()) config = loadOdometryConfig(opt.config);
+  if (!opt.config.empty()) config = harness::loadOdometryConfig(opt.config);
   if (opt.reinitialise) config.reinitialise_after_lost = true;
 
   harness::Sequence seq = harness::loadSequence(opt.sequence);

@@ -94,4 +94,42 @@ control::CascadeConfig loadCascadeConfig(const std::filesystem::path& yaml, cont
   return c;
 }
 
+vo::OdometryConfig loadOdometryConfig(const std::filesystem::path& yaml, vo::OdometryConfig c) {
+  const YamlDoc doc = YamlDoc::load(yaml);
+  FieldReader(doc, doc.root(), "")
+      .section("features",
+               [&](FieldReader r) {
+                 vo::FeatureConfig& f = c.features;
+                 r.read("max_features", f.max_features)
+                     .read("grid_cols", f.grid_cols)
+                     .read("grid_rows", f.grid_rows)
+                     .read("fast_threshold", f.fast_threshold)
+                     .read("scale_factor", f.scale_factor)
+                     .read("pyramid_levels", f.pyramid_levels)
+                     .read("edge_threshold_px", f.edge_threshold_px)
+                     .finish();
+               })
+      .read("min_depth_m", c.min_depth_m)
+      .read("max_depth_m", c.max_depth_m)
+      .read("depth_edge_m", c.depth_edge_m)
+      .read("init_min_features", c.init_min_features)
+      .read("min_inliers", c.min_inliers)
+      .read("weak_inliers", c.weak_inliers)
+      .read("search_radius_px", c.search_radius_px)
+      .read("max_descriptor_distance", c.max_descriptor_distance)
+      .read("ratio_test", c.ratio_test)
+      .read("ransac_reprojection_px", c.ransac_reprojection_px)
+      .read("ransac_iterations", c.ransac_iterations)
+      .read("ransac_confidence", c.ransac_confidence)
+      .read("local_map_keyframes", c.local_map_keyframes)
+      .read("keyframe_inlier_ratio", c.keyframe_inlier_ratio)
+      .read("keyframe_translation_m", c.keyframe_translation_m)
+      .read("keyframe_rotation_rad", c.keyframe_rotation_rad)
+      .read("landmark_max_misses", c.landmark_max_misses)
+      .read("reinitialise_after_lost", c.reinitialise_after_lost)
+      .finish();
+  validateFrom(doc, c);
+  return c;
+}
+
 }  // namespace tgnav::harness

@@ -5,11 +5,13 @@
 
 #include "control/cascade.h"
 #include "harness/camera.h"
+#include "vo/odometry.h"
 
 namespace tgnav::harness {
 
 CameraConfig loadCameraConfig(const std::filesystem::path& yaml, CameraConfig base = {});
-control::CascadeConfig loadCascadeConfig(const std::filesystem::path& yaml,
-                                         control::CascadeConfig base = {});
+control::CascadeConfig loadCascadeConfig(const std::filesystem::path& yaml, control::CascadeConfig base = {});
+// Keys are the fields of vo::OdometryConfig, `features:` those of vo::FeatureConfig.
+vo::OdometryConfig loadOdometryConfig(const std::filesystem::path& yaml, vo::OdometryConfig base = {});
 
 }  // namespace tgnav::harness

@@ -37,9 +37,9 @@ Eigen::Vector4d UniformBSpline::basis(double u, int derivative) {
   }
 }
 
-void UniformBSpline::locate(double t, int* span, double* u) const {
-  const double x = std::clamp(t / dt_, 0.0, static_cast<double>(spans()));
-  const int i = std::min(static_cast<int>(std::floor(x)), spans() - 1);
+void UniformBSpline::locate(double t, double dt, int spans, int* span, double* u) {
+  const double x = std::clamp(t / dt, 0.0, static_cast<double>(spans));
+  const int i = std::min(static_cast<int>(std::floor(x)), spans - 1);
   *span = i;
   *u = x - i;
 }

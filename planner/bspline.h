@@ -31,7 +31,9 @@ class UniformBSpline {
   // Weights of Q_i .. Q_{i+3} for d^k/du^k at u in [0, 1] (divide by dt^k for time derivatives).
   static Eigen::Vector4d basis(double u, int derivative);
   // Span and u of time t (clamped to the curve).
-  void locate(double t, int* span, double* u) const;
+  void locate(double t, int* span, double* u) const { locate(t, dt_, spans(), span, u); }
+  // The same for any uniform spline of `spans` spans, `dt` apart.
+  static void locate(double t, double dt, int spans, int* span, double* u);
 
  private:
   Eigen::MatrixXd q_;

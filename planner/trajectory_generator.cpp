@@ -261,7 +261,7 @@ class SplineFit {
     for (const FitSample& s : reference) {
       int i = 0;
       double u = 0.0;
-      locate(s.t, spans, &i, &u);
+      UniformBSpline::locate(s.t, dt_, spans, &i, &u);
       const Eigen::Vector4d b = UniformBSpline::basis(u, 0);
       const Eigen::RowVectorXd e = b.transpose() * q_.middleRows(i, 4) - s.value.transpose();
       f += w_ref * ref_h * e.squaredNorm();
@@ -309,12 +309,6 @@ class SplineFit {
       }
     }
     return f;
-  }
-
-  void locate(double t, int spans, int* i, double* u) const {
-    const double x = std::clamp(t / dt_, 0.0, static_cast<double>(spans));
-    *i = std::min(static_cast<int>(std::floor(x)), spans - 1);
-    *u = x - *i;
   }
 
   Eigen::MatrixXd q_;

@@ -16,18 +16,10 @@
 #include <string>
 #include <vector>
 
+#include "vo/camera_intrinsics.h"
 #include "vo/features.h"
 
 namespace tgnav::vo {
-
-struct CameraIntrinsics {
-  int width_px = 0;
-  int height_px = 0;
-  double fx = 0.0;
-  double fy = 0.0;
-  double cx = 0.0;
-  double cy = 0.0;
-};
 
 struct OdometryConfig {
   FeatureConfig features;

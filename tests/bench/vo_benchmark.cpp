@@ -75,8 +75,7 @@ void BM_VoOurs(benchmark::State& state) {
   int lost = 0, frames = 0;
   double seconds = 0.0;
   for (auto _ : state) {
-    vo::RgbdOdometry odometry(vo::CameraIntrinsics{k.width_px, k.height_px, k.fx, k.fy, k.cx, k.cy},
-                              vo::OdometryConfig{}, s.frames.front().X_WC);
+    vo::RgbdOdometry odometry(k, vo::OdometryConfig{}, s.frames.front().X_WC);
     est.clear();
     lost = 0;
     const auto t0 = std::chrono::steady_clock::now();

@@ -47,8 +47,7 @@ VoRun flyPast(const std::vector<planner::Pose4>& poses, const std::function<void
     setVehiclePose(model.get(), data.get(), ids, poses[i]);
     const RgbdFrame frame = camera.render(data.get());
     if (!odometry) {
-      odometry = std::make_unique<vo::RgbdOdometry>(
-          vo::CameraIntrinsics{k.width_px, k.height_px, k.fx, k.fy, k.cx, k.cy}, vo::OdometryConfig{}, frame.X_WC);
+      odometry = std::make_unique<vo::RgbdOdometry>(k, vo::OdometryConfig{}, frame.X_WC);
     }
     const double t = 0.05 * static_cast<double>(i);
     run.results.push_back(odometry->track(t, frame.bgr, frame.depth_m));
