@@ -47,8 +47,7 @@ Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px) {
 }
 
 Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed)
-    : model_(m), gl_(gl), config_(config), rng_(seed) {
-  config_.validate();
+    : model_(m), gl_(gl), config_(config), noise_(config, seed) {
   cam_id_ = mj_name2id(m, mjOBJ_CAMERA, config_.name.c_str());
   if (cam_id_ < 0) throw InputError("camera '" + config_.name + "' is not in the model");
 
@@ -114,6 +113,12 @@ Eigen::Isometry3d Camera::pose(const mjData* d) const {
 }
 
 RgbdFrame Camera::render(mjData* d) {
+  RgbdFrame frame = renderNoiseless(d);
+  noise_.apply(&frame);
+  return frame;
+}
+
+RgbdFrame Camera::renderNoiseless(mjData* d) {
   gl_.makeCurrent();
   const int w = config_.width_px;
   const int h = config_.height_px;
@@ -129,9 +134,8 @@ RgbdFrame Camera::render(mjData* d) {
   frame.X_WC = pose(d);
   frame.bgr.create(h, w, CV_8UC3);
   frame.depth_m.create(h, w, CV_32FC1);
-  std::normal_distribution<double> unit(0.0, 1.0);
-  const bool rgb_noise = config_.rgb_noise_sigma > 0.0;
-  const bool depth_noise = config_.depth_noise_sigma_per_m2 > 0.0;
+  const auto min_depth = static_cast<float>(config_.min_depth_m);
+  const auto max_depth = static_cast<float>(config_.max_depth_m);
   // OpenGL rows run bottom-up; images run top-down.
   for (int row = 0; row < h; ++row) {
     const std::size_t src_row = static_cast<std::size_t>(h - 1 - row) * w;
@@ -139,18 +143,49 @@ RgbdFrame Camera::render(mjData* d) {
     auto* depth = frame.depth_m.ptr<float>(row);
     for (int col = 0; col < w; ++col) {
       const unsigned char* rgb = &rgb_buffer_[3 * (src_row + col)];
-      for (int ch = 0; ch < 3; ++ch) {
-        double value = rgb[2 - ch];
-        if (rgb_noise) value += config_.rgb_noise_sigma * unit(rng_);
-        bgr[col][ch] = cv::saturate_cast<unsigned char>(value);
-      }
-      double z = linearizeDepth(depth_buffer_[src_row + col], near_m_, far_m_);
-      if (depth_noise) z += config_.depth_noise_sigma_per_m2 * z * z * unit(rng_);
-      depth[col] = (z >= config_.min_depth_m && z <= config_.max_depth_m) ? static_cast<float>(z)
-                                                                           : 0.0f;
+      bgr[col] = cv::Vec3b(rgb[2], rgb[1], rgb[0]);
+      const auto z = static_cast<float>(linearizeDepth(depth_buffer_[src_row + col], near_m_, far_m_));
+      depth[col] = (z >= min_depth && z <= max_depth) ? z : 0.0f;
     }
   }
   return frame;
+}
+
+CameraNoise::CameraNoise(const CameraConfig& config, std::uint64_t seed)
+    : rgb_sigma_(config.rgb_noise_sigma),
+      depth_k_(config.depth_noise_sigma_per_m2),
+      min_depth_m_(config.min_depth_m),
+      max_depth_m_(config.max_depth_m),
+      // cv::RNG treats a zero state as a fixed non-zero one; keep every seed distinct from it.
+      rng_(seed ^ 0x9E3779B97F4A7C15ULL) {
+  config.validate();
+}
+
+void CameraNoise::apply(RgbdFrame* frame) {
+  if (rgb_sigma_ > 0.0) {
+    noise_.create(frame->bgr.size(), CV_32FC3);
+    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, rgb_sigma_);
+    cv::Mat noisy;
+    frame->bgr.convertTo(noisy, CV_32FC3);
+    noisy += noise_;
+    noisy.convertTo(frame->bgr, CV_8UC3);  // rounds and saturates
+  }
+  if (depth_k_ > 0.0) {
+    noise_.create(frame->depth_m.size(), CV_32FC1);
+    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, 1.0);
+    const auto k = static_cast<float>(depth_k_);
+    const auto lo = static_cast<float>(min_depth_m_);
+    const auto hi = static_cast<float>(max_depth_m_);
+    for (int row = 0; row < frame->depth_m.rows; ++row) {
+      auto* z = frame->depth_m.ptr<float>(row);
+      const auto* n = noise_.ptr<float>(row);
+      for (int col = 0; col < frame->depth_m.cols; ++col) {
+        if (z[col] <= 0.0f) continue;  // invalid stays invalid
+        const float noisy = z[col] + k * z[col] * z[col] * n[col];
+        z[col] = (noisy >= lo && noisy <= hi) ? noisy : 0.0f;
+      }
+    }
+  }
 }
 
 }  // namespace tgnav::harness

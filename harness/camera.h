@@ -10,7 +10,6 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <opencv2/core.hpp>
-#include <random>
 #include <string>
 
 #include "harness/egl_context.h"
@@ -43,6 +42,23 @@ struct RgbdFrame {
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
 };
 
+// The sensor noise of CameraConfig, seeded: Gaussian noise on every colour channel and depth
+// noise of sigma k z^2 on valid depths (a noisy depth outside [min, max] becomes invalid).
+// Frames must be noised in order for a seed to give the same noise.
+class CameraNoise {
+ public:
+  CameraNoise(const CameraConfig& config, std::uint64_t seed);
+  void apply(RgbdFrame* frame);
+
+ private:
+  double rgb_sigma_;
+  double depth_k_;
+  double min_depth_m_;
+  double max_depth_m_;
+  cv::RNG rng_;
+  cv::Mat noise_;  // scratch
+};
+
 class Camera {
  public:
   // Makes `gl` current and allocates MuJoCo's render context. Writes the offscreen buffer
@@ -54,8 +70,11 @@ class Camera {
   Camera(Camera&&) = delete;
   Camera& operator=(Camera&&) = delete;
 
-  // Renders the current state of `d` (kinematics must be up to date, e.g. after mj_step).
+  // Renders the current state of `d` (kinematics must be up to date, e.g. after mj_step), with
+  // the configured noise.
   RgbdFrame render(mjData* d);
+  // The same without noise: what a pipeline renders on one thread and noises on another.
+  RgbdFrame renderNoiseless(mjData* d);
   // Pose of C in W for the current state of `d`.
   Eigen::Isometry3d pose(const mjData* d) const;
   const Intrinsics& intrinsics() const { return intrinsics_; }
@@ -74,7 +93,7 @@ class Camera {
   mjrContext context_{};
   std::vector<unsigned char> rgb_buffer_;
   std::vector<float> depth_buffer_;
-  std::mt19937_64 rng_;
+  CameraNoise noise_;
 };
 
 // Pose of camera `cam_id` in its parent body's frame (vision convention), fixed by the model.

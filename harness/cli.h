@@ -11,6 +11,7 @@ void addRenderCommand(CLI::App& app);
 void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
+void addTrialCommand(CLI::App& app);
 void addVoCommand(CLI::App& app);
 
 // Parses "a,b,c" into exactly `count` finite numbers; InputError naming `option` otherwise.

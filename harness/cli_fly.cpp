@@ -17,16 +17,13 @@
 #include "harness/output.h"
 #include "harness/scene_config.h"
 #include "harness/trajectory_csv.h"
+#include "harness/trial.h"
 #include "harness/tum_sequence.h"
 #include "vo/tum.h"
 
 namespace tgnav::cli {
 
 namespace {
-
-// Height of the centre of mass above the ground when landed: hull half-height 0.03 m of
-// models/quadrotor.xml plus 5 mm of clearance; the vehicle settles onto the floor.
-constexpr double kLandedHeightM = 0.035;
 
 struct FlyOptions {
   std::string scene;
@@ -146,11 +143,11 @@ void runFly(const FlyOptions& opt) {
   planner::Pose4 landed = scene.start;
   if (has_scene_yaml) {
     checkAgainstScene(scene, traj, flight, opt.trajectory);
-    landed.p_WB.z() = scene.bounds_min_m.z() + kLandedHeightM;
+    landed.p_WB.z() = scene.bounds_min_m.z() + harness::kLandedHeightM;
   } else {
     // A bare MJCF has no start pose: take off below the first setpoint, from z = 0.
     landed.p_WB = traj.setpoints().front().p_WB;
-    landed.p_WB.z() = kLandedHeightM;
+    landed.p_WB.z() = harness::kLandedHeightM;
     landed.yaw_rad = traj.setpoints().front().yaw_rad;
   }
   harness::setVehiclePose(model.get(), data.get(), ids, landed);
@@ -165,7 +162,7 @@ void runFly(const FlyOptions& opt) {
   std::unique_ptr<harness::Camera> camera;
   std::unique_ptr<harness::SequenceWriter> writer;
   harness::DataPtr view;
-  harness::StepHook after_step;
+  harness::FlightHooks hooks;
   auto capture = [&] {
     mj_copyData(view.get(), model.get(), data.get());
     mj_kinematics(model.get(), view.get());
@@ -178,8 +175,9 @@ void runFly(const FlyOptions& opt) {
     gl = std::make_unique<harness::EglContext>();
     camera = std::make_unique<harness::Camera>(model.get(), *gl, record.camera, opt.seed);
     writer = std::make_unique<harness::SequenceWriter>(opt.record, camera->intrinsics());
-    after_step = [&](const harness::FlightLoop& l) {
+    hooks.after_step = [&](const harness::FlightLoop& l) {
       if (l.steps() % record.steps_per_frame == 0) capture();
+      return std::string();
     };
   }
 
@@ -193,21 +191,14 @@ void runFly(const FlyOptions& opt) {
 
   const auto wall0 = std::chrono::steady_clock::now();
   if (recording) capture();  // the first frame, on the ground at t = 0
-  const harness::FlightResult result = harness::flyTrajectory(loop, traj, flight, after_step);
+  const harness::FlightResult result = harness::flyTrajectory(loop, traj, flight, hooks);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const harness::TrackingSummary summary = harness::summarizeTracking(result);
 
   const int cam_id = mj_name2id(model.get(), mjOBJ_CAMERA, "front");
   const Eigen::Isometry3d X_BC =
       cam_id >= 0 ? harness::cameraInBody(model.get(), cam_id) : Eigen::Isometry3d::Identity();
-  std::vector<vo::StampedPose> gt;
-  gt.reserve(result.log.size());
-  for (const auto& f : result.log) {
-    Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
-    X_WB.linear() = f.state.q_WB.toRotationMatrix();
-    X_WB.translation() = f.state.p_WB;
-    gt.push_back(vo::StampedPose{f.t_s, X_WB * X_BC});
-  }
+  const std::vector<vo::StampedPose> gt = harness::cameraPoses(result, X_BC);
   const bool completed = result.status == harness::FlightStatus::kCompleted;
   nlohmann::ordered_json j;
   j["status"] = completed ? "completed" : "diverged";

@@ -1,7 +1,5 @@
 // tgnav plan: on a scene's feature map (--scenario: proposed, agnostic or rrtstar), or
 // topological planning on a 2D occupancy grid (--grid: ROS map_server or MovingAI).
-#include <unistd.h>
-
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -14,7 +12,6 @@
 #include "harness/map_cache.h"
 #include "harness/output.h"
 #include "harness/plan_run.h"
-#include "harness/quiet_stderr.h"
 #include "harness/scenario.h"
 #include "harness/trajectory_csv.h"
 #include "planner/topological_planner.h"
@@ -155,29 +152,6 @@ void runPlanGrid(const PlanOptions& opt) {
   }
 }
 
-// The scene's feature map: --map DIR as given, else the cache (built on first use).
-planner::FeatureMap loadSceneMap(const PlanOptions& opt, const harness::Scenario& scenario) {
-  std::filesystem::path dir = opt.map;
-  if (dir.empty()) {
-    const std::filesystem::path cache =
-        opt.map_cache.empty() ? harness::defaultCacheDir() : std::filesystem::path(opt.map_cache);
-    const bool tty = isatty(fileno(stderr)) != 0;
-    const harness::CachedMap cached =
-        harness::cachedFeatureMap(scenario.scene, harness::MapBuildConfig{}, cache, [&](int done, int total) {
-          if (tty && (done % 20 == 0 || done == total))
-            std::fprintf(stderr, "\rtgnav plan: mapping %d/%d frames", done, total);
-        });
-    if (tty && cached.built) std::fprintf(stderr, "\n");
-    dir = cached.dir;
-  }
-  try {
-    const harness::QuietStderr quiet;
-    return planner::FeatureMap::load(dir);
-  } catch (const std::runtime_error& e) {
-    throw InputError(std::string("--map: ") + e.what());
-  }
-}
-
 void runPlanScenario(const PlanOptions& opt) {
   if (!opt.start.empty() || !opt.goal.empty()) {
     throw InputError("--start/--goal: with --scenario, start and goal come from the scenario or its scene");
@@ -192,7 +166,7 @@ void runPlanScenario(const PlanOptions& opt) {
   const harness::Scenario scenario = harness::loadScenario(opt.scenario);
   const std::uint64_t seed = opt.seed >= 0 ? static_cast<std::uint64_t>(opt.seed) : scenario.seed;
   const std::filesystem::path out(opt.out);
-  const planner::FeatureMap map = loadSceneMap(opt, scenario);
+  const planner::FeatureMap map = harness::loadSceneFeatureMap(scenario.scene, opt.map, opt.map_cache, "tgnav plan");
   const harness::PlanRun run = harness::runPlanner(scenario, map, name, seed, opt.samples);
   harness::makeOutputDir(out);
   const planner::TrajectoryReport& tr = run.trajectory;

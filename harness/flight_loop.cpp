@@ -60,10 +60,11 @@ bool FlightLoop::checkDiverged() {
   return !divergence_.empty();
 }
 
-bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) {
+bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) { return step(setpoint, state()); }
+
+bool FlightLoop::step(const control::TrajectorySetpoint& setpoint, const control::VehicleState& s) {
   if (!divergence_.empty()) return false;
   const double dt = m_->opt.timestep;
-  const control::VehicleState s = state();
   if (steps_ % per_position_ == 0) cascade_.updatePosition(s, setpoint, per_position_ * dt);
   if (steps_ % per_attitude_ == 0) cascade_.updateAttitude(s.q_WB);
   if (steps_ % per_rate_ == 0) {
@@ -79,25 +80,38 @@ bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) {
   return !checkDiverged();
 }
 
+FlightTimeline flightTimeline(const FlightLoop& loop, const control::SetpointTrajectory& trajectory,
+                              const FlightConfig& config) {
+  const double climb_m = trajectory.setpoints().front().p_WB.z() - loop.state().p_WB.z();
+  // Smoothstep climb (zero speed at both ends) whose peak speed is takeoff_speed_m_s.
+  const double climb_s = 1.5 * std::abs(climb_m) / config.takeoff_speed_m_s;
+  FlightTimeline timeline;
+  timeline.takeoff_s = loop.time();
+  timeline.climb_end_s = timeline.takeoff_s + climb_s;
+  timeline.trajectory_start_s = timeline.climb_end_s + config.settle_s;
+  timeline.end_s = timeline.trajectory_start_s + (trajectory.endTime() - trajectory.startTime()) + config.hold_s;
+  return timeline;
+}
+
 FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory, const FlightConfig& config,
-                           const StepHook& after_step) {
+                           const FlightHooks& hooks) {
   config.validate();
   loop.setDivergenceLimits(config.diverged_tilt_rad, config.diverged_speed_m_s);
   FlightResult result;
   const control::TrajectorySetpoint first = trajectory.sample(trajectory.startTime());
   const control::VehicleState start = loop.state();
   const double climb_m = first.p_WB.z() - start.p_WB.z();
-  // Smoothstep climb (zero speed at both ends) whose peak speed is takeoff_speed_m_s.
-  const double climb_s = 1.5 * std::abs(climb_m) / config.takeoff_speed_m_s;
-  const double t0 = loop.time();
-  result.trajectory_start_s = t0 + climb_s + config.settle_s;
-  const double t_end = result.trajectory_start_s + (trajectory.endTime() - trajectory.startTime()) + config.hold_s;
+  const FlightTimeline timeline = flightTimeline(loop, trajectory, config);
+  const double t0 = timeline.takeoff_s;
+  const double climb_s = timeline.climb_end_s - t0;
+  result.trajectory_start_s = timeline.trajectory_start_s;
+  const double t_end = timeline.end_s;
 
   while (loop.time() < t_end - 1e-9) {
     const double t = loop.time();
     control::TrajectorySetpoint sp;
     bool on_trajectory = false;
-    if (t < t0 + climb_s) {
+    if (t < timeline.climb_end_s) {
       const double s = (t - t0) / climb_s;
       sp.p_WB = Eigen::Vector3d(first.p_WB.x(), first.p_WB.y(), start.p_WB.z() + climb_m * s * s * (3 - 2 * s));
       sp.v_WB = Eigen::Vector3d(0.0, 0.0, climb_m * 6 * s * (1 - s) / climb_s);
@@ -113,14 +127,22 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
       sp = trajectory.sample(tt);
       on_trajectory = tt <= trajectory.endTime();
     }
-    const bool log_now = loop.positionUpdateDue();
-    if (log_now) result.log.push_back(FlightSample{t, on_trajectory, sp, loop.state()});
-    if (!loop.step(sp)) {
+    const control::VehicleState truth = loop.state();
+    const control::VehicleState flown_on = hooks.control_state ? hooks.control_state(loop) : truth;
+    if (loop.positionUpdateDue()) result.log.push_back(FlightSample{t, on_trajectory, sp, truth, flown_on});
+    if (!loop.step(sp, flown_on)) {
       result.status = FlightStatus::kDiverged;
       result.reason = loop.divergence();
       break;
     }
-    if (after_step) after_step(loop);
+    if (hooks.after_step) {
+      std::string stop = hooks.after_step(loop);
+      if (!stop.empty()) {
+        result.status = FlightStatus::kStopped;
+        result.reason = std::move(stop);
+        break;
+      }
+    }
   }
   return result;
 }

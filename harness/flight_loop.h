@@ -1,7 +1,8 @@
 #pragma once
 // Closed loop of MuJoCo and the PX4-like cascade: physics every step, rate control and
 // allocation at rate_rate_hz, attitude at attitude_rate_hz, position at position_rate_hz.
-// State comes from ground truth (the paper flew its vehicle on motion capture).
+// The controller flies on ground truth (the paper flew its vehicle on motion capture) unless
+// the caller hands it an estimate (FlightHooks::control_state).
 #include <mujoco/mujoco.h>
 
 #include <functional>
@@ -34,6 +35,9 @@ class FlightLoop {
   // diverged or a command was not finite; motor commands then stay unchanged and divergence()
   // says why. Nothing non-finite ever reaches MuJoCo.
   bool step(const control::TrajectorySetpoint& setpoint);
+  // The same, with the controller flying on `control_state` instead of ground truth (divergence
+  // is still judged on the true state).
+  bool step(const control::TrajectorySetpoint& setpoint, const control::VehicleState& control_state);
   control::VehicleState state() const { return vehicleState(d_, ids_); }
   double time() const { return d_->time; }
   long steps() const { return steps_; }  // physics steps taken by this loop
@@ -60,32 +64,48 @@ class FlightLoop {
   std::string divergence_;
 };
 
-enum class FlightStatus { kCompleted, kDiverged };
+enum class FlightStatus { kCompleted, kDiverged, kStopped };
 
 struct FlightSample {
   double t_s = 0.0;
   bool on_trajectory = false;  // false during take-off, settling and the final hold
   control::TrajectorySetpoint setpoint;
-  control::VehicleState state;
+  control::VehicleState state;     // true
+  control::VehicleState estimate;  // what the controller flew on (= state on ground truth)
 };
 
 struct FlightResult {
   FlightStatus status = FlightStatus::kCompleted;
-  std::string reason;               // why it diverged
+  std::string reason;               // why it diverged or was stopped
   double trajectory_start_s = 0.0;  // sim time at which the trajectory's first setpoint applied
   std::vector<FlightSample> log;    // at the position-loop rate
 };
 
-// Called after every physics step that did not diverge (e.g. to render the onboard camera).
-// It must leave the state the next step reads (qpos, qvel, act, ctrl) alone; recomputing
-// kinematics (mj_kinematics, mj_camlight) is fine, mj_step recomputes them anyway.
-using StepHook = std::function<void(const FlightLoop& loop)>;
+struct FlightHooks {
+  // The state the controller flies on, asked before every physics step (unset: ground truth).
+  std::function<control::VehicleState(const FlightLoop& loop)> control_state;
+  // Called after every physics step that did not diverge (e.g. to render the onboard camera);
+  // a non-empty return stops the flight (kStopped) with that reason. It must leave the state
+  // the next step reads (qpos, qvel, act, ctrl) alone; recomputing kinematics (mj_kinematics,
+  // mj_camlight) is fine, mj_step recomputes them anyway.
+  std::function<std::string(const FlightLoop& loop)> after_step;
+};
+
+// When the phases of flyTrajectory begin, from the loop's current time and state.
+struct FlightTimeline {
+  double takeoff_s = 0.0;           // climb from the current pose to the first setpoint
+  double climb_end_s = 0.0;
+  double trajectory_start_s = 0.0;  // after the climb and settle_s
+  double end_s = 0.0;               // after the trajectory and hold_s
+};
+FlightTimeline flightTimeline(const FlightLoop& loop, const control::SetpointTrajectory& trajectory,
+                              const FlightConfig& config);
 
 // Takes off from the vehicle's current (landed) pose to the trajectory's first setpoint,
-// settles, flies the trajectory and holds its end. `after_step`, when set, runs after each
-// physics step; the flight is the same with or without it.
+// settles, flies the trajectory and holds its end. Hooks that only observe leave the flight
+// unchanged.
 FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& trajectory, const FlightConfig& config,
-                           const StepHook& after_step = nullptr);
+                           const FlightHooks& hooks = {});
 
 struct TrackingSummary {
   double duration_s = 0.0;

@@ -54,9 +54,12 @@ int main(int argc, char** argv) {
   tgnav::cli::addFlyCommand(app);
   tgnav::cli::addMapCommand(app);
   tgnav::cli::addPlanCommand(app);
+  tgnav::cli::addTrialCommand(app);
   tgnav::cli::addVoCommand(app);
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {  // a command's own exit code (e.g. 130: interrupted)
+    return e.get_exit_code();
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -113,6 +114,28 @@ CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& confi
   }
   out.built = true;
   return out;
+}
+
+planner::FeatureMap loadSceneFeatureMap(const SceneConfig& scene, const std::string& map_dir,
+                                        const std::string& cache_root, const std::string& command) {
+  std::filesystem::path dir = map_dir;
+  if (dir.empty()) {
+    const std::filesystem::path cache = cache_root.empty() ? defaultCacheDir() : std::filesystem::path(cache_root);
+    const bool tty = isatty(fileno(stderr)) != 0;
+    const CachedMap cached = cachedFeatureMap(scene, MapBuildConfig{}, cache, [&](int done, int total) {
+      if (tty && (done % 20 == 0 || done == total)) {
+        std::fprintf(stderr, "\r%s: mapping %d/%d frames", command.c_str(), done, total);
+      }
+    });
+    if (tty && cached.built) std::fprintf(stderr, "\n");
+    dir = cached.dir;
+  }
+  try {
+    const QuietStderr quiet;
+    return planner::FeatureMap::load(dir);
+  } catch (const std::runtime_error& e) {
+    throw InputError(std::string("--map: ") + e.what());
+  }
 }
 
 }  // namespace tgnav::harness

@@ -10,6 +10,7 @@
 
 #include "harness/map_builder.h"
 #include "harness/scene_config.h"
+#include "planner/feature_map.h"
 
 namespace tgnav::harness {
 
@@ -28,5 +29,12 @@ struct CachedMap {
 CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& config,
                            const std::filesystem::path& cache_root,
                            const std::function<void(int done, int total)>& progress = {});
+
+// The scene's feature map for a command: the folder `map_dir` when given (`--map`), else the
+// cached one under `cache_root` (`--map-cache`, default defaultCacheDir()), built on first use
+// with progress on stderr when that is a terminal ("<command>: mapping i/n frames").
+// InputError naming --map when the folder holds no readable map.
+planner::FeatureMap loadSceneFeatureMap(const SceneConfig& scene, const std::string& map_dir,
+                                        const std::string& cache_root, const std::string& command);
 
 }  // namespace tgnav::harness

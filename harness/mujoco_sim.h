@@ -47,6 +47,10 @@ struct VehicleIds {
   static VehicleIds find(const mjModel* m, const std::string& source);
 };
 
+// Height of the centre of mass above the ground when landed: hull half-height 0.03 m of
+// models/quadrotor.xml plus 5 mm of clearance; the vehicle settles onto the floor.
+constexpr double kLandedHeightM = 0.035;
+
 // Places the vehicle level at `pose` with zero velocity and recomputes kinematics.
 void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const planner::Pose4& pose);
 

@@ -102,6 +102,13 @@ void readPlannerSettings(FieldReader r, PlannerSettings* s) {
   s->trajectory.robot_radius_m = p.robot_radius_m;
 }
 
+YAML::Node toYaml(const PlannerSettings& s) {
+  PlannerSettings copy = s;
+  YAML::Node out(YAML::NodeType::Map);
+  readPlannerSettings(FieldReader::writer(out), &copy);
+  return out;
+}
+
 void validatePlannerSettings(const PlannerSettings& s, const std::string& source) {
   try {
     s.validate();

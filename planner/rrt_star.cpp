@@ -368,10 +368,14 @@ Plan PerceptionRrtStar::solve(const Pose4& start, const Pose4& goal, std::uint64
   std::vector<const ob::State*> states;
   auto* solution = pdef->getSolutionPath()->as<og::PathGeometric>();
   for (std::size_t i = 0; i < solution->getStateCount(); ++i) states.push_back(solution->getState(i));
-  // The tree ends within the tolerance of the goal; finish at the goal pose itself when that last
-  // step is clear.
-  if (!space->equalStates(states.back(), g0.get()) && si->checkMotion(states.back(), g0.get())) {
-    states.push_back(g0.get());
+  // The tree ends within the tolerance of the goal; finish at the goal position when that last
+  // step is clear, keeping the heading the tree arrived with: the goal region leaves yaw free (as
+  // the pose graph of the proposed planner does), so no final turn on the spot is added.
+  ob::ScopedState<ob::SE2StateSpace> finish(space);
+  finish->setXY(goal.p_WB.x(), goal.p_WB.y());
+  finish->setYaw(states.back()->as<Se2State>()->getYaw());
+  if (!space->equalStates(states.back(), finish.get()) && si->checkMotion(states.back(), finish.get())) {
+    states.push_back(finish.get());
   }
 
   CandidatePath candidate;

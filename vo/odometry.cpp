@@ -268,13 +268,15 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
 
   // Pose: PnP RANSAC from the prediction, Levenberg-Marquardt on the inliers, inliers again.
   const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
-  cv::Mat rvec, tvec;
+  cv::Mat r_pred, t_pred;
   {
     cv::Mat R;
     cv::eigen2cv(Eigen::Matrix3d(X_CW_pred.linear()), R);
-    cv::Rodrigues(R, rvec);
-    cv::eigen2cv(Eigen::Vector3d(X_CW_pred.translation()), tvec);
+    cv::Rodrigues(R, r_pred);
+    cv::eigen2cv(Eigen::Vector3d(X_CW_pred.translation()), t_pred);
   }
+  cv::Mat rvec = r_pred.clone();
+  cv::Mat tvec = t_pred.clone();
   std::vector<int> inliers;
   const bool ok = cv::solvePnPRansac(object, pixels, K, cv::noArray(), rvec, tvec, true, config_.ransac_iterations,
                                      static_cast<float>(config_.ransac_reprojection_px), config_.ransac_confidence,
@@ -289,32 +291,51 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     obj_in.push_back(object[static_cast<std::size_t>(i)]);
     pix_in.push_back(pixels[static_cast<std::size_t>(i)]);
   }
-  cv::solvePnPRefineLM(obj_in, pix_in, K, cv::noArray(), rvec, tvec);
-  cv::Mat R;
-  cv::Rodrigues(rvec, R);
-  Eigen::Matrix3d R_CW;
-  Eigen::Vector3d t_CW;
-  cv::cv2eigen(R, R_CW);
-  cv::cv2eigen(tvec, t_CW);
-  Eigen::Isometry3d X_CW = Eigen::Isometry3d::Identity();
-  X_CW.linear() = R_CW;
-  X_CW.translation() = t_CW;
-  if (!X_CW.matrix().allFinite()) return lose("PnP gave a non-finite pose");
-
-  // Inliers of the refined pose.
-  std::vector<bool> is_inlier(object.size(), false);
+  // Levenberg-Marquardt on RANSAC's inliers from two starts: RANSAC's pose, which EPnP on a
+  // near-planar set (a wall filling the view) can get badly wrong, and the motion-model
+  // prediction. The start whose refined pose has more inliers among all matches wins.
   const double thr2 = config_.ransac_reprojection_px * config_.ransac_reprojection_px;
-  int n_in = 0;
-  for (std::size_t m = 0; m < object.size(); ++m) {
-    const Eigen::Vector3d q = X_CW * Eigen::Vector3d(object[m].x, object[m].y, object[m].z);
-    if (q.z() <= 0.0) continue;
-    const double du = camera_.fx * q.x() / q.z() + camera_.cx - pixels[m].x;
-    const double dv = camera_.fy * q.y() / q.z() + camera_.cy - pixels[m].y;
-    if (du * du + dv * dv <= thr2) {
-      is_inlier[m] = true;
-      ++n_in;
+  auto refine = [&](cv::Mat r, cv::Mat t, Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) {
+    cv::solvePnPRefineLM(obj_in, pix_in, K, cv::noArray(), r, t);
+    cv::Mat R;
+    cv::Rodrigues(r, R);
+    Eigen::Matrix3d R_CW;
+    Eigen::Vector3d t_CW;
+    cv::cv2eigen(R, R_CW);
+    cv::cv2eigen(t, t_CW);
+    X_CW->setIdentity();
+    X_CW->linear() = R_CW;
+    X_CW->translation() = t_CW;
+    is_inlier->assign(object.size(), false);
+    if (!X_CW->matrix().allFinite()) return -1;
+    int n = 0;
+    for (std::size_t m = 0; m < object.size(); ++m) {
+      const Eigen::Vector3d q = *X_CW * Eigen::Vector3d(object[m].x, object[m].y, object[m].z);
+      if (q.z() <= 0.0) continue;
+      const double du = camera_.fx * q.x() / q.z() + camera_.cx - pixels[m].x;
+      const double dv = camera_.fy * q.y() / q.z() + camera_.cy - pixels[m].y;
+      if (du * du + dv * dv <= thr2) {
+        (*is_inlier)[m] = true;
+        ++n;
+      }
+    }
+    return n;
+  };
+  Eigen::Isometry3d X_CW;
+  std::vector<bool> is_inlier;
+  int n_in = refine(rvec, tvec, &X_CW, &is_inlier);
+  {
+    Eigen::Isometry3d X_CW_alt;
+    std::vector<bool> alt_inlier;
+    const int n_alt = refine(r_pred, t_pred, &X_CW_alt, &alt_inlier);
+    if (n_alt > n_in) {
+      n_in = n_alt;
+      X_CW = X_CW_alt;
+      is_inlier = std::move(alt_inlier);
     }
   }
+  if (n_in < 0) return lose("PnP gave a non-finite pose");
+
   result.inliers = n_in;
   if (n_in < config_.min_inliers) {
     return lose(std::to_string(n_in) + " inliers < " + std::to_string(config_.min_inliers));

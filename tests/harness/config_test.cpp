@@ -2,9 +2,16 @@
 // file, the line, the key and the value.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <stdexcept>
+
 #include "harness/config_io.h"
 #include "harness/errors.h"
+#include "harness/planner_config.h"
+#include "harness/scenario.h"
 #include "harness/scene_config.h"
+#include "harness/trial_config.h"
+#include "harness/yaml_util.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -126,6 +133,512 @@ TEST_F(SceneErrors, SurveyYawCountMustBeAnInteger) {
 TEST(SceneFile, UnknownExtensionIsRejected) {
   const auto file = test::writeFile(test::tempDir() / "scene.txt", "x");
   EXPECT_NE(inputError([&] { loadScene(file); }).find("unknown scene file type"), std::string::npos);
+}
+
+// --- Writer mode: the read functions, run the other way, emit every key ----------------------
+
+std::string dump(const YAML::Node& node) {
+  YAML::Emitter out;
+  out << node;
+  return out.c_str();
+}
+
+// The dotted paths of all keys of `node`, in order.
+std::vector<std::string> keyPaths(const YAML::Node& node, const std::string& context = "") {
+  std::vector<std::string> keys;
+  for (const auto& kv : node) {
+    const std::string key = joinKey(context, kv.first.as<std::string>());
+    keys.push_back(key);
+    if (kv.second.IsMap()) {
+      const std::vector<std::string> inner = keyPaths(kv.second, key);
+      keys.insert(keys.end(), inner.begin(), inner.end());
+    }
+  }
+  return keys;
+}
+
+TEST(ConfigWriter, WritesExactShortestDecimalsAndTypedScalars) {
+  YAML::Node out(YAML::NodeType::Map);
+  double tenth = 0.1, micro = 1e-6, twenty = 20.0, third = 1.0 / 3.0, negative = -2.5;
+  int count = -7;
+  bool flag = true;
+  std::string name = "front";
+  Eigen::Vector3d v(0.15, 1e-6, -3.0);
+  FieldReader::writer(out)
+      .read("tenth", tenth)
+      .read("micro", micro)
+      .read("twenty", twenty)
+      .read("third", third)
+      .read("negative", negative)
+      .read("count", count)
+      .read("flag", flag)
+      .read("name", name)
+      .read("v", v)
+      .section("inner", [](FieldReader r) {
+        double x = 4.0;
+        EXPECT_TRUE(r.writing());
+        r.read("x", x).finish();
+      })
+      .finish();
+  EXPECT_EQ(out["tenth"].Scalar(), "0.1");
+  EXPECT_EQ(out["micro"].Scalar(), "1e-06");
+  EXPECT_EQ(out["twenty"].Scalar(), "20");
+  EXPECT_EQ(std::stod(out["third"].Scalar()), third);  // exact, not rounded to 6 digits
+  EXPECT_EQ(out["negative"].Scalar(), "-2.5");
+  EXPECT_EQ(out["count"].Scalar(), "-7");
+  EXPECT_EQ(out["flag"].Scalar(), "true");
+  EXPECT_EQ(out["name"].Scalar(), "front");
+  EXPECT_EQ(out["inner"]["x"].Scalar(), "4");
+  EXPECT_NE(dump(out).find("v: [0.15, 1e-06, -3]"), std::string::npos) << dump(out);
+  EXPECT_EQ(keyPaths(out), (std::vector<std::string>{"tenth", "micro", "twenty", "third", "negative", "count",
+                                                     "flag", "name", "v", "inner", "inner.x"}));
+}
+
+// Emits `c`, loads the text back with `load` and emits that: the two texts must be identical.
+template <typename Config, typename Load>
+Config roundTrip(const Config& c, Load load, const std::filesystem::path& dir) {
+  const std::string text = dump(toYaml(c));
+  const Config back = load(test::writeFile(dir / "config.yaml", text + "\n"));
+  EXPECT_EQ(dump(toYaml(back)), text);
+  return back;
+}
+
+TEST(ConfigRoundTrip, CameraDefaultsAndChangedValues) {
+  const auto dir = test::tempDir();
+  roundTrip(CameraConfig{}, [](const auto& f) { return loadCameraConfig(f); }, dir);
+  CameraConfig c;
+  c.name = "down";
+  c.width_px = 321;
+  c.near_clip_m = 0.1 / 3.0;
+  c.min_depth_m = 0.1;
+  c.depth_noise_sigma_per_m2 = 1e-6;
+  const CameraConfig back = roundTrip(c, [](const auto& f) { return loadCameraConfig(f); }, dir);
+  EXPECT_EQ(back.name, "down");
+  EXPECT_EQ(back.width_px, 321);
+  EXPECT_EQ(back.near_clip_m, c.near_clip_m);
+  EXPECT_EQ(back.depth_noise_sigma_per_m2, 1e-6);
+}
+
+TEST(ConfigRoundTrip, CascadeDefaultsAndChangedValues) {
+  const auto dir = test::tempDir();
+  roundTrip(control::CascadeConfig{}, [](const auto& f) { return loadCascadeConfig(f); }, dir);
+  control::CascadeConfig c;
+  c.rate.p = Eigen::Vector3d(0.1 / 3.0, 0.17, 0.21);
+  c.position.tilt_max_rad = M_PI / 5;
+  c.attitude_rate_hz = 125.0;
+  const control::CascadeConfig back = roundTrip(c, [](const auto& f) { return loadCascadeConfig(f); }, dir);
+  EXPECT_EQ(back.rate.p, c.rate.p);
+  EXPECT_EQ(back.position.tilt_max_rad, c.position.tilt_max_rad);
+  EXPECT_EQ(back.attitude_rate_hz, 125.0);
+  EXPECT_EQ(keyPaths(toYaml(back)).size(), (1u + 3u) + (1u + 16u) + (1u + 7u) + (1u + 6u));
+}
+
+TEST(ConfigRoundTrip, OdometryDefaultsAndChangedValues) {
+  const auto dir = test::tempDir();
+  roundTrip(vo::OdometryConfig{}, [](const auto& f) { return loadOdometryConfig(f); }, dir);
+  vo::OdometryConfig c;
+  c.features.scale_factor = 1.0 + 1.0 / 7.0;
+  c.features.max_features = 777;
+  c.ransac_confidence = 0.9999;
+  c.reinitialise_after_lost = true;
+  const vo::OdometryConfig back = roundTrip(c, [](const auto& f) { return loadOdometryConfig(f); }, dir);
+  EXPECT_EQ(back.features.scale_factor, c.features.scale_factor);
+  EXPECT_EQ(back.features.max_features, 777);
+  EXPECT_EQ(back.ransac_confidence, 0.9999);
+  EXPECT_TRUE(back.reinitialise_after_lost);
+}
+
+TEST(ConfigRoundTrip, TrialDefaultsAndChangedValues) {
+  const auto dir = test::tempDir();
+  roundTrip(TrialConfig{}, [](const auto& f) { return loadTrialConfig(f); }, dir);
+  TrialConfig c;
+  c.state_source = StateSource::kVo;
+  c.pipeline = false;
+  c.camera_rate_hz = 25.0;
+  c.flight.diverged_tilt_rad = 1.0 / 3.0;
+  c.imu.gyro_bias_rad_s = 1e-4;
+  c.estimator.attitude_gain = 0.35;
+  const TrialConfig back = roundTrip(c, [](const auto& f) { return loadTrialConfig(f); }, dir);
+  EXPECT_EQ(back.state_source, StateSource::kVo);
+  EXPECT_FALSE(back.pipeline);
+  EXPECT_EQ(back.camera_rate_hz, 25.0);
+  EXPECT_EQ(back.flight.diverged_tilt_rad, c.flight.diverged_tilt_rad);
+  EXPECT_EQ(back.imu.gyro_bias_rad_s, 1e-4);
+  EXPECT_EQ(back.estimator.attitude_gain, 0.35);
+}
+
+TEST(ConfigRoundTrip, PlannerDefaultsAndChangedValues) {
+  const auto dir = test::tempDir();
+  roundTrip(PlannerSettings{}, [](const auto& f) { return loadPlannerSettings(f); }, dir);
+  PlannerSettings c;
+  c.perception.robot_radius_m = 0.35;
+  c.perception.visibility.hfov_rad = M_PI / 3;
+  c.rrt_star.samples = 1234;
+  c.trajectory.max_iterations = 77;
+  const PlannerSettings back = roundTrip(c, [](const auto& f) { return loadPlannerSettings(f); }, dir);
+  EXPECT_EQ(back.perception.robot_radius_m, 0.35);
+  EXPECT_EQ(back.rrt_star.robot_radius_m, 0.35);  // follows perception's
+  EXPECT_EQ(back.trajectory.robot_radius_m, 0.35);
+  EXPECT_EQ(back.perception.visibility.hfov_rad, M_PI / 3);
+  EXPECT_EQ(back.rrt_star.samples, 1234);
+  EXPECT_EQ(back.trajectory.max_iterations, 77);
+}
+
+// --- Shipped files hold every key at its built-in default -------------------------------------
+
+template <typename Config, typename Load>
+void expectShippedDefaults(const std::string& name, Load load) {
+  const auto file = test::sourceDir() / "configs" / name;
+  EXPECT_EQ(dump(toYaml(load(file))), dump(toYaml(Config{}))) << name << " differs from the built-in defaults";
+  EXPECT_EQ(keyPaths(YAML::LoadFile(file.string())), keyPaths(toYaml(Config{})))
+      << name << " does not list every key in the order toYaml writes them";
+}
+
+TEST(ConfigShippedFiles, VoYamlEqualsBuiltInDefaults) {
+  expectShippedDefaults<vo::OdometryConfig>("vo.yaml", [](const auto& f) { return loadOdometryConfig(f); });
+}
+
+TEST(ConfigShippedFiles, TrialYamlEqualsBuiltInDefaults) {
+  expectShippedDefaults<TrialConfig>("trial.yaml", [](const auto& f) { return loadTrialConfig(f); });
+}
+
+TEST(ConfigShippedFiles, CameraYamlListsEveryKey) {
+  expectShippedDefaults<CameraConfig>("camera.yaml", [](const auto& f) { return loadCameraConfig(f); });
+}
+
+TEST(ConfigShippedFiles, ControllerYamlListsEveryKey) {
+  expectShippedDefaults<control::CascadeConfig>("controller.yaml",
+                                                [](const auto& f) { return loadCascadeConfig(f); });
+}
+
+TEST(ConfigShippedFiles, PlannerYamlListsEveryKey) {
+  expectShippedDefaults<PlannerSettings>("planner.yaml", [](const auto& f) { return loadPlannerSettings(f); });
+}
+
+// --- Trial settings ------------------------------------------------------------------------
+
+TEST(ConfigTrial, StateSourceNames) {
+  StateSource s = StateSource::kGroundTruth;
+  EXPECT_TRUE(parseStateSource("vo", &s));
+  EXPECT_EQ(s, StateSource::kVo);
+  EXPECT_TRUE(parseStateSource("gt", &s));
+  EXPECT_EQ(s, StateSource::kGroundTruth);
+  EXPECT_FALSE(parseStateSource("GT", &s));
+  EXPECT_FALSE(parseStateSource("", &s));
+  EXPECT_EQ(s, StateSource::kGroundTruth);  // unchanged on failure
+  EXPECT_STREQ(toString(StateSource::kVo), "vo");
+  EXPECT_STREQ(toString(StateSource::kGroundTruth), "gt");
+}
+
+TEST(ConfigTrial, UnknownStateSourceNamesKeyAndValue) {
+  const auto file = test::writeFile(test::tempDir() / "trial.yaml", "camera_rate_hz: 10\nstate_source: mocap\n");
+  const std::string msg = inputError([&] { loadTrialConfig(file); });
+  EXPECT_NE(msg.find(file.string() + ":2: key 'state_source' has value 'mocap', expected one of gt, vo"),
+            std::string::npos)
+      << msg;
+}
+
+template <typename Config>
+std::string invalidArgument(const Config& config) {
+  try {
+    config.validate();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ConfigTrial, ImuValidationNamesFieldAndValue) {
+  EXPECT_EQ(invalidArgument(ImuConfig{}), "");
+  ImuConfig imu;
+  imu.accel_noise_m_s2 = -1.0;
+  EXPECT_EQ(invalidArgument(imu), "accel_noise_m_s2 = -1: must be >= 0");
+  imu = ImuConfig{};
+  imu.gyro_bias_rad_s = std::nan("");
+  EXPECT_EQ(invalidArgument(imu).rfind("gyro_bias_rad_s = ", 0), 0u) << invalidArgument(imu);
+  imu = ImuConfig{};
+  imu.accel_bias_m_s2 = 0.0;  // a perfect IMU is allowed
+  EXPECT_EQ(invalidArgument(imu), "");
+}
+
+TEST(ConfigTrial, TrialValidationNamesDottedFieldAndValue) {
+  EXPECT_EQ(invalidArgument(TrialConfig{}), "");
+  TrialConfig t;
+  t.camera_rate_hz = 0.0;
+  EXPECT_EQ(invalidArgument(t), "camera_rate_hz = 0: must be > 0");
+  t = TrialConfig{};
+  t.goal_radius_m = -0.5;
+  EXPECT_EQ(invalidArgument(t), "goal_radius_m = -0.5: must be > 0");
+  t = TrialConfig{};
+  t.flight.takeoff_speed_m_s = 0.0;
+  EXPECT_EQ(invalidArgument(t).rfind("flight.takeoff_speed_m_s", 0), 0u) << invalidArgument(t);
+  t = TrialConfig{};
+  t.imu.gyro_noise_rad_s = -2.0;
+  EXPECT_EQ(invalidArgument(t), "imu.gyro_noise_rad_s = -2: must be >= 0");
+  t = TrialConfig{};
+  t.estimator.history_s = 0.0;
+  EXPECT_EQ(invalidArgument(t).rfind("estimator.history_s", 0), 0u) << invalidArgument(t);
+}
+
+// --- --set overrides -----------------------------------------------------------------------
+
+TEST(ConfigOverrides, NestedKeysListsAndScalars) {
+  const YamlDoc doc = YamlDoc::fromOverrides({"start=[1, 2, 1, 0.5]", "trial.state_source=vo", "camera.width_px=320",
+                                              "camera.height_px=240", "planner.rrt_star.samples=500",
+                                              "vo.features.max_features=800", "trial.imu={gyro_bias_rad_s: 0}"});
+  EXPECT_TRUE(doc.isOverrides());
+  const YAML::Node& r = doc.root();
+  ASSERT_TRUE(r["start"].IsSequence());
+  EXPECT_EQ(r["start"].size(), 4u);
+  EXPECT_EQ(r["start"][3].Scalar(), "0.5");
+  EXPECT_EQ(r["trial"]["state_source"].Scalar(), "vo");
+  EXPECT_EQ(r["camera"]["width_px"].Scalar(), "320");
+  EXPECT_EQ(r["camera"]["height_px"].Scalar(), "240");
+  EXPECT_EQ(r["planner"]["rrt_star"]["samples"].Scalar(), "500");
+  EXPECT_EQ(r["vo"]["features"]["max_features"].Scalar(), "800");
+  EXPECT_EQ(r["trial"]["imu"]["gyro_bias_rad_s"].Scalar(), "0");
+  EXPECT_EQ(keyPaths(r), (std::vector<std::string>{"start", "trial", "trial.state_source", "trial.imu",
+                                                   "trial.imu.gyro_bias_rad_s", "camera", "camera.width_px",
+                                                   "camera.height_px", "planner", "planner.rrt_star",
+                                                   "planner.rrt_star.samples", "vo", "vo.features",
+                                                   "vo.features.max_features"}));
+  EXPECT_EQ(keyPaths(YamlDoc::fromOverrides({}).root()).size(), 0u);
+}
+
+TEST(ConfigOverrides, ErrorsAtANodeNameItsAssignment) {
+  const YamlDoc doc = YamlDoc::fromOverrides({"seed=2", "camera={width_px: [3]}", "trial.pipeline=maybe"});
+  EXPECT_EQ(doc.name(), "--set overrides");
+  EXPECT_EQ(inputError([&] { doc.fail(doc.root()["camera"]["width_px"][0], "bad"); }),
+            "--set camera={width_px: [3]}: bad");
+  EXPECT_EQ(inputError([&] { doc.fail(doc.root()["trial"]["pipeline"], "bad"); }), "--set trial.pipeline=maybe: bad");
+  EXPECT_EQ(inputError([&] { doc.fail(doc.root()["trial"], "bad"); }), "--set overrides: bad");
+  EXPECT_EQ(doc.assignmentFor("camera.width_px"), "camera={width_px: [3]}");
+  EXPECT_EQ(doc.assignmentFor("trial"), "trial.pipeline=maybe");
+  EXPECT_EQ(doc.assignmentFor("vo"), "");
+}
+
+TEST(ConfigOverrides, MalformedAssignmentsAreNamed) {
+  const auto error = [](const std::vector<std::string>& a) { return inputError([&] { YamlDoc::fromOverrides(a); }); };
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"camera.width_px"}, "--set camera.width_px: no '='"},
+      {{"=3"}, "--set =3: empty key"},
+      {{"a..b=1"}, "--set a..b=1: empty segment in key 'a..b'"},
+      {{".a=1"}, "--set .a=1: empty segment"},
+      {{"a.=1"}, "--set a.=1: empty segment"},
+      {{"a=1", "a.b=2"}, "--set a.b=2: key 'a' is both a value and a mapping"},
+      {{"a.b.c=2", "a.b=1"}, "--set a.b=1: key 'a.b' is both a value and a mapping"},
+      {{"a.b=1", "a.c=1", "a.b=2"}, "--set a.b=2: key 'a.b' is set twice"},
+      {{"seed="}, "--set seed=: no value"},
+      {{"start=[1, 2"}, "--set start=[1, 2: YAML syntax error"},
+  };
+  for (const auto& [assignments, expected] : cases) {
+    const std::string msg = error(assignments);
+    EXPECT_EQ(msg.rfind(expected, 0), 0u) << "got: " << msg << "\nexpected: " << expected;
+  }
+}
+
+class ConfigScenario : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::tempDir(); }
+  std::filesystem::path scenario(const std::string& body) {
+    return test::writeFile(dir_ / "scenario.yaml",
+                           "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
+  }
+  std::string error(const std::filesystem::path& file, const std::vector<std::string>& set) {
+    const YamlDoc overrides = YamlDoc::fromOverrides(set);
+    return inputError([&] { loadScenario(file, &overrides); });
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(ConfigScenario, WrongTypeViaSetNamesTheAssignment) {
+  const std::string msg = error(scenario(""), {"seed=4", "camera.width_px=abc"});
+  EXPECT_EQ(msg, "--set camera.width_px=abc: key 'camera.width_px' has value 'abc', expected an integer");
+  EXPECT_EQ(error(scenario(""), {"start=[1, 2, 1]"}),
+            "--set start=[1, 2, 1]: key 'start' has value '[1, 2, 1]', expected a list of 4 finite numbers");
+  EXPECT_EQ(error(scenario(""), {"trial.state_source=mocap"}),
+            "--set trial.state_source=mocap: key 'trial.state_source' has value 'mocap', expected one of gt, vo");
+  EXPECT_EQ(error(scenario(""), {"seed=-2"}), "--set seed=-2: key 'seed' has value '-2', expected an integer >= 0");
+  EXPECT_EQ(error(scenario(""), {"camera=5"}), "--set camera=5: 'camera' must be a mapping");
+  EXPECT_EQ(error(scenario(""), {"goal=[9, 0, 1, 0]"}).rfind("--set goal=[9, 0, 1, 0]: key 'goal' lies outside", 0),
+            0u);
+}
+
+TEST_F(ConfigScenario, UnknownKeyViaSetNamesTheAssignment) {
+  const std::string msg = error(scenario(""), {"camera.widht_px=320"});
+  EXPECT_EQ(msg.rfind("--set camera.widht_px=320: unknown key 'camera.widht_px' (allowed: name, width_px,", 0), 0u)
+      << msg;
+  const std::string top = error(scenario(""), {"camra.width_px=320"});
+  EXPECT_EQ(top.rfind("--set camra.width_px=320: unknown key 'camra' (allowed: scene, seed, start, goal,", 0), 0u)
+      << top;
+  const std::string nested = error(scenario(""), {"vo={features: {max_feature: 3}}"});
+  EXPECT_EQ(nested.rfind("--set vo={features: {max_feature: 3}}: unknown key 'vo.features.max_feature'", 0), 0u)
+      << nested;
+}
+
+TEST_F(ConfigScenario, ConfigFileKeysCannotBeSet) {
+  const std::string msg = error(scenario(""), {"camera_config=cam.yaml"});
+  EXPECT_EQ(msg.rfind("--set camera_config=cam.yaml: key 'camera_config' names a file and cannot be set with --set", 0),
+            0u)
+      << msg;
+}
+
+TEST_F(ConfigScenario, ValidationFailureNamesTheAssignmentOrTheFile) {
+  const auto file = scenario("vo: {weak_inliers: 40}\n");
+  const std::string camera = error(file, {"camera.max_depth_m=-1"});
+  EXPECT_EQ(camera.rfind("--set camera.max_depth_m=-1: max_depth_m = -1", 0), 0u) << camera;
+  // Nested configs name their fields without the nesting; the one --set key of that name is meant.
+  EXPECT_EQ(error(file, {"controller.position.pos_p_xy=-1"}),
+            "--set controller.position.pos_p_xy=-1: pos_p_xy = -1: must be > 0");
+  EXPECT_EQ(error(file, {"trial.imu.accel_bias_m_s2=-1"}),
+            "--set trial.imu.accel_bias_m_s2=-1: imu.accel_bias_m_s2 = -1: must be >= 0");
+  // The offending key is the file's; the override only made it invalid.
+  EXPECT_EQ(error(file, {"vo.min_inliers=50"}),
+            file.string() + " (with --set overrides): weak_inliers = 40: must be >= min_inliers");
+  // Without overrides the file alone is named.
+  EXPECT_EQ(error(scenario("trial: {goal_radius_m: 0}\n"), {}), file.string() + ": goal_radius_m = 0: must be > 0");
+}
+
+TEST_F(ConfigScenario, LayersDefaultsFileInlineAndOverrides) {
+  test::writeFile(dir_ / "cam.yaml", "width_px: 400\nheight_px: 300\nnear_clip_m: 0.06\nrgb_noise_sigma: 1\n");
+  test::writeFile(dir_ / "trial.yaml", "state_source: vo\ncamera_rate_hz: 25\nflight: {hold_s: 3}\n");
+  test::writeFile(dir_ / "vo.yaml", "min_inliers: 20\nweak_inliers: 40\n");
+  test::writeFile(dir_ / "ctl.yaml", "position: {vel_p_xy: 2.5}\n");
+  const auto file = scenario(
+      "camera_config: cam.yaml\ncamera: {height_px: 320, rgb_noise_sigma: 2}\n"
+      "trial_config: trial.yaml\ntrial: {camera_rate_hz: 50, flight: {settle_s: 0.5}}\n"
+      "vo_config: vo.yaml\ncontroller_config: ctl.yaml\ncontroller: {rates_hz: {position: 50}}\n"
+      "planner: {rrt_star: {samples: 300}}\nstart: [-2, 0, 1, 0]\n");
+  const YamlDoc overrides = YamlDoc::fromOverrides({"camera.rgb_noise_sigma=3", "trial.flight.settle_s=0.25",
+                                                    "vo.features.max_features=600", "seed=9", "goal=[2, 1, 1.5, 0.1]",
+                                                    "controller.position.vel_p_xy=2"});
+  const Scenario s = loadScenario(file, &overrides);
+  const CameraConfig defaults;
+  EXPECT_EQ(s.camera.width_px, 400);                        // file
+  EXPECT_EQ(s.camera.near_clip_m, 0.06);                    // file
+  EXPECT_EQ(s.camera.height_px, 320);                       // inline over file
+  EXPECT_EQ(s.camera.rgb_noise_sigma, 3.0);                 // --set over inline over file
+  EXPECT_EQ(s.camera.far_clip_m, defaults.far_clip_m);      // default
+  EXPECT_EQ(s.trial.state_source, StateSource::kVo);        // file
+  EXPECT_EQ(s.trial.camera_rate_hz, 50.0);                  // inline
+  EXPECT_EQ(s.trial.flight.hold_s, 3.0);                    // file, in a section
+  EXPECT_EQ(s.trial.flight.settle_s, 0.25);                 // --set
+  EXPECT_EQ(s.trial.goal_radius_m, TrialConfig{}.goal_radius_m);
+  EXPECT_EQ(s.vo.min_inliers, 20);
+  EXPECT_EQ(s.vo.features.max_features, 600);
+  EXPECT_EQ(s.vo.features.grid_cols, vo::FeatureConfig{}.grid_cols);
+  EXPECT_EQ(s.controller.position.vel_p_xy, 2.0);
+  EXPECT_EQ(s.controller.position_rate_hz, 50.0);
+  EXPECT_EQ(s.controller.attitude_rate_hz, control::CascadeConfig{}.attitude_rate_hz);
+  EXPECT_EQ(s.planner.rrt_star.samples, 300);
+  EXPECT_EQ(s.seed, 9u);
+  EXPECT_EQ(s.scene.start.p_WB, Eigen::Vector3d(-2, 0, 1));  // scenario over scene
+  EXPECT_EQ(s.scene.goal.p_WB, Eigen::Vector3d(2, 1, 1.5));  // --set
+  EXPECT_EQ(s.scene.goal.yaw_rad, 0.1);
+
+  // Without the overrides, the file and inline layers alone.
+  const Scenario plain = loadScenario(file);
+  EXPECT_EQ(plain.camera.rgb_noise_sigma, 2.0);
+  EXPECT_EQ(plain.trial.flight.settle_s, 0.5);
+  EXPECT_EQ(plain.seed, 3u);
+  EXPECT_EQ(plain.scene.goal.p_WB, Eigen::Vector3d(3, 0, 1));  // the scene's
+}
+
+TEST_F(ConfigScenario, SceneOverrideIsRelativeToTheCurrentDirectory) {
+  const auto file = scenario("");
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  std::filesystem::current_path(test::sourceDir() / "configs");
+  const YamlDoc good = YamlDoc::fromOverrides({"scene=scenes/corridor.yaml"});
+  std::string msg;
+  Scenario s;
+  try {
+    s = loadScenario(file, &good);
+    msg = error(file, {"scene=scenes/nowhere.yaml"});
+  } catch (...) {
+    std::filesystem::current_path(cwd);
+    throw;
+  }
+  std::filesystem::current_path(cwd);
+  EXPECT_EQ(s.scene.source, test::sourceDir() / "configs/scenes/corridor.yaml");
+  EXPECT_EQ(msg.rfind("--set scene=scenes/nowhere.yaml: key 'scene' has value 'scenes/nowhere.yaml': file ", 0), 0u)
+      << msg;
+}
+
+TEST_F(ConfigScenario, SectionsDefaultAndMessagesStay) {
+  for (const char* name : {"smoke", "storage", "gallery", "corridor"}) {
+    EXPECT_EQ(inputError([&] { loadScenario(test::sourceDir() / "configs/scenarios" / (std::string(name) + ".yaml")); }),
+              "")
+        << name;
+  }
+  const Scenario s = loadScenario(scenario(""));
+  EXPECT_EQ(s.seed, 3u);
+  EXPECT_EQ(dump(toYaml(s.planner)), dump(toYaml(PlannerSettings{})));
+  EXPECT_EQ(dump(toYaml(s.camera)), dump(toYaml(CameraConfig{})));
+  EXPECT_EQ(dump(toYaml(s.controller)), dump(toYaml(control::CascadeConfig{})));
+  EXPECT_EQ(dump(toYaml(s.vo)), dump(toYaml(vo::OdometryConfig{})));
+  EXPECT_EQ(dump(toYaml(s.trial)), dump(toYaml(TrialConfig{})));
+  const auto bad_seed = test::writeFile(dir_ / "bad.yaml", "scene: " +
+                                                               (test::sourceDir() / "configs/scenes/smoke.yaml").string() +
+                                                               "\nseed: -1\n");
+  EXPECT_EQ(inputError([&] { loadScenario(bad_seed); }),
+            bad_seed.string() + ":2: key 'seed' has value '-1', expected an integer >= 0");
+  const auto unknown = scenario("cammera: {}\n");
+  EXPECT_NE(inputError([&] { loadScenario(unknown); }).find(unknown.string() + ":3: unknown key 'cammera'"),
+            std::string::npos);
+  const auto missing = scenario("camera_config: nowhere.yaml\n");
+  EXPECT_NE(inputError([&] { loadScenario(missing); }).find("key 'camera_config' has value 'nowhere.yaml': file"),
+            std::string::npos);
+}
+
+// --- The resolved scenario loads back to itself ----------------------------------------------
+
+void expectSameScenario(const Scenario& a, const Scenario& b) {
+  EXPECT_EQ(a.scene.source, b.scene.source);
+  EXPECT_EQ(a.scene.mjcf, b.scene.mjcf);
+  EXPECT_EQ(a.seed, b.seed);
+  EXPECT_EQ(a.scene.start.p_WB, b.scene.start.p_WB);
+  EXPECT_EQ(a.scene.start.yaw_rad, b.scene.start.yaw_rad);
+  EXPECT_EQ(a.scene.goal.p_WB, b.scene.goal.p_WB);
+  EXPECT_EQ(a.scene.goal.yaw_rad, b.scene.goal.yaw_rad);
+  EXPECT_EQ(dump(toYaml(a.planner)), dump(toYaml(b.planner)));
+  EXPECT_EQ(dump(toYaml(a.controller)), dump(toYaml(b.controller)));
+  EXPECT_EQ(dump(toYaml(a.camera)), dump(toYaml(b.camera)));
+  EXPECT_EQ(dump(toYaml(a.vo)), dump(toYaml(b.vo)));
+  EXPECT_EQ(dump(toYaml(a.trial)), dump(toYaml(b.trial)));
+}
+
+TEST_F(ConfigScenario, ResolvedStorageScenarioLoadsBackIdentically) {
+  const Scenario s = loadScenario(test::sourceDir() / "configs/scenarios/storage.yaml");
+  const std::string text = resolvedScenarioYaml(s);
+  const Scenario back = loadScenario(test::writeFile(dir_ / "resolved.yaml", text));
+  expectSameScenario(s, back);
+  EXPECT_EQ(resolvedScenarioYaml(back), text);
+  EXPECT_EQ(text.rfind("# ", 0), 0u);
+  EXPECT_NE(text.find("\nscene: " + (test::sourceDir() / "configs/scenes/storage.yaml").lexically_normal().string() +
+                      "\nseed: 1\nstart: ["),
+            std::string::npos)
+      << text;
+  for (const char* key : {"\nplanner:\n", "\ncontroller:\n", "\ncamera:\n", "\nvo:\n", "\ntrial:\n"}) {
+    EXPECT_NE(text.find(key), std::string::npos) << key;
+  }
+}
+
+TEST_F(ConfigScenario, ResolvedScenarioWithOverridesLoadsBackIdentically) {
+  const auto file = scenario("camera: {width_px: 320, height_px: 240}\ntrial: {state_source: vo}\n");
+  const YamlDoc overrides = YamlDoc::fromOverrides(
+      {"start=[-2.9, 0.1, 1.1, 0.1]", "goal=[2.7, -0.3, 1.3, 0.7853981633974483]", "seed=12",
+       "camera.depth_noise_sigma_per_m2=0.002", "vo.ratio_test=0.7", "trial.imu.gyro_bias_rad_s=1e-4",
+       "controller.rate.p=[0.1, 0.1, 0.3]", "planner.selection.c_p_threshold=5.5"});
+  const Scenario s = loadScenario(file, &overrides);
+  const std::string text = resolvedScenarioYaml(s);
+  EXPECT_NE(text.find("start: [-2.9, 0.1, 1.1, 0.1]"), std::string::npos) << text;
+  EXPECT_NE(text.find("gyro_bias_rad_s: 1e-04"), std::string::npos) << text;
+  const Scenario back = loadScenario(test::writeFile(dir_ / "resolved.yaml", text));
+  expectSameScenario(s, back);
+  EXPECT_EQ(back.camera.width_px, 320);
+  EXPECT_EQ(back.trial.state_source, StateSource::kVo);
+  EXPECT_EQ(back.controller.rate.p, Eigen::Vector3d(0.1, 0.1, 0.3));
+  EXPECT_EQ(resolvedScenarioYaml(back), text);
 }
 
 }  // namespace
