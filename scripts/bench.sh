@@ -3,7 +3,8 @@
 # with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
 # the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
 # storage and gallery with every planner (results/bench/plans/), which also times trajectory
-# generation on the chosen paths.
+# generation on the chosen paths, and runs closed-loop trials (results/bench/trials/) for their
+# wall time, real-time factor and peak memory.
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -44,6 +45,15 @@ for scene in storage gallery; do
   done
 done
 
+# Closed-loop trials: storage, proposed planner (the VO tracks the whole flight, so every frame is
+# rendered and tracked), at 640x480 and 320x240, camera and VO at 20 Hz, render and VO pipelined.
+rm -rf "$out/trials"
+for size in 640x480 320x240; do
+  "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" --map "$out/maps/storage" \
+    --planner proposed --seed 1 --set camera.width_px="${size%x*}" --set camera.height_px="${size#*x}" \
+    --out "$out/trials/storage-proposed-$size" >&2
+done
+
 sha=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
 /usr/bin/python3 - "$out" "$sha" <<'PY'
 import json, os, socket, sys, datetime
@@ -65,6 +75,11 @@ for key, runs in groups.items():
     rows.append({"benchmark": f"plan/{key}", "figure": "path_length_m", "value": runs[0]["path_length_m"]})
     trajectory_s = sorted(p["timing"]["trajectory_s"] for p in runs)
     rows.append({"benchmark": f"plan/{key}", "figure": "median_traj_s", "value": trajectory_s[len(trajectory_s) // 2]})
+trials = os.path.join(out, "trials")
+for run in sorted(os.listdir(trials)) if os.path.isdir(trials) else []:
+    m = json.load(open(os.path.join(trials, run, "metrics.json")))
+    for figure in ("wall_time_s", "flight_wall_s", "real_time_factor", "peak_rss_mb"):
+        rows.append({"benchmark": f"trial/{run}", "figure": figure, "value": m["timing"][figure]})
 for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "bench.json"):
     data = json.load(open(os.path.join(out, name)))
     for b in data["benchmarks"]:

@@ -18,21 +18,10 @@
 namespace tgnav {
 namespace {
 
-struct CmdResult {
-  int rc = -1;
-  std::string output;  // stdout and stderr
-};
+using test::CmdResult;
 
 CmdResult tgnav(const std::string& args, const std::string& env = "") {
-  const std::string cmd = env + " " + TGNAV_BIN + " " + args + " 2>&1";
-  CmdResult run;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
-  const int status = pclose(pipe);
-  run.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return test::runShell(env + " " + TGNAV_BIN + " " + args);
 }
 
 std::string smoke() { return (test::sourceDir() / "configs/scenes/smoke.yaml").string(); }

@@ -1,7 +1,10 @@
 #pragma once
 // Helpers shared by the harness tests.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
+#include <array>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -28,6 +31,23 @@ inline std::filesystem::path tempDir() {
 inline std::filesystem::path writeFile(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path) << text;
   return path;
+}
+
+struct CmdResult {
+  int rc = -1;
+  std::string output;  // stdout and stderr
+};
+
+// Runs a shell command line; its output (stderr included) and exit code.
+inline CmdResult runShell(const std::string& command) {
+  CmdResult run;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return run;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
+  const int status = pclose(pipe);
+  run.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
 }
 
 // The message of the InputError that `fn` throws ("" when it throws none).

@@ -2,7 +2,6 @@
 // at 320x240, what a trial writes, determinism (same seed, pipelined vs sequential), flying on
 // the VO, and the contract on bad input and interruption.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <array>
 #include <cstdio>
@@ -11,36 +10,17 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "../harness/test_util.h"
 #include "harness/scenario.h"
 #include "vo/tum.h"
 
 namespace tgnav {
 namespace {
 
-struct CmdResult {
-  int rc = -1;
-  std::string output;  // stdout and stderr
-};
+using test::CmdResult;
+CmdResult shell(const std::string& cmd) { return test::runShell(cmd); }
 
-CmdResult shell(const std::string& cmd) {
-  CmdResult run;
-  FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
-  const int status = pclose(pipe);
-  run.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
-
-std::filesystem::path tempDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  auto dir = std::filesystem::temp_directory_path() /
-             ("tgnav_smoke_" + std::string(info->test_suite_name()) + "_" + info->name());
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+using test::tempDir;
 
 const std::string kScenario = std::string(TGNAV_SOURCE_DIR) + "/configs/scenarios/smoke.yaml";
 // 320x240 keeps a smoke flight well under a minute on two cores.
