@@ -343,15 +343,14 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
 
     // Contacts: once the vehicle has climbed clear of the ground, any contact is a collision
     // (before, it settles and lifts off on the floor).
+    const Eigen::Vector3d p = l.state().p_WB;
     int partner = -1;
     for (int i = 0; i < d->ncon && partner < 0; ++i) partner = contactPartner(model.get(), d->contact[i], vehicle_root);
-    if (l.state().p_WB.z() > landed.p_WB.z() + kLiftOffM) airborne = true;
+    if (p.z() > landed.p_WB.z() + kLiftOffM) airborne = true;
     if (partner >= 0 && airborne) {
-      const Eigen::Vector3d p = l.state().p_WB;
       result.collision = TrialEvent{l.time(), p, geomName(model.get(), partner)};
       return "collision with " + result.collision->what + " at " + formatPoint(p);
     }
-    const Eigen::Vector3d p = l.state().p_WB;
     constexpr double kBoundsSlackM = 1.0;
     if ((p.array() < scenario.scene.bounds_min_m.array() - kBoundsSlackM).any() ||
         (p.array() > scenario.scene.bounds_max_m.array() + kBoundsSlackM).any()) {
