@@ -57,15 +57,7 @@ RecordPlan planRecording(const FlyOptions& opt, const mjModel* model) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--width/--height: ") + e.what());
   }
-  const double physics_hz = 1.0 / model->opt.timestep;
-  const double ratio = physics_hz / opt.record_rate_hz;
-  plan.steps_per_frame = std::isfinite(ratio) ? static_cast<int>(std::lround(ratio)) : 0;
-  if (!(opt.record_rate_hz > 0.0) || plan.steps_per_frame < 1 || std::abs(ratio - plan.steps_per_frame) > 1e-6) {
-    std::ostringstream msg;
-    msg << "--record-rate: " << opt.record_rate_hz << " Hz does not divide the physics rate of " << physics_hz
-        << " Hz (e.g. 10, 20, 25, 50)";
-    throw InputError(msg.str());
-  }
+  plan.steps_per_frame = harness::stepsPerTick(model, opt.record_rate_hz, "--record-rate:");
   auto normal = [](const std::string& dir) {
     const std::filesystem::path p = std::filesystem::absolute(dir).lexically_normal();
     return p.has_filename() ? p : p.parent_path();  // "seq/" is "seq"

@@ -21,26 +21,24 @@ void FlightConfig::validate() const {
   positive(diverged_speed_m_s, "diverged_speed_m_s");
 }
 
-namespace {
-int stepsPer(double physics_hz, double loop_hz, const char* name) {
-  const double ratio = physics_hz / loop_hz;
-  const int n = static_cast<int>(std::lround(ratio));
+int stepsPerTick(const mjModel* m, double rate_hz, const std::string& what) {
+  const double physics_hz = 1.0 / m->opt.timestep;
+  const double ratio = physics_hz / rate_hz;
+  const int n = std::isfinite(ratio) ? static_cast<int>(std::lround(ratio)) : 0;
   if (n < 1 || std::abs(ratio - n) > 1e-6) {
     std::ostringstream msg;
-    msg << "controller " << name << " = " << loop_hz << " Hz does not divide the physics rate of " << physics_hz
-        << " Hz";
+    msg << what << " " << rate_hz << " Hz does not divide the physics rate of " << physics_hz
+        << " Hz (e.g. 10, 20, 25, 50)";
     throw InputError(msg.str());
   }
   return n;
 }
-}  // namespace
 
 FlightLoop::FlightLoop(mjModel* m, mjData* d, const VehicleIds& ids, const control::CascadeConfig& config)
     : m_(m), d_(d), ids_(ids), vehicle_(vehicleParamsFromModel(m, ids)), cascade_(config, vehicle_) {
-  const double physics_hz = 1.0 / m->opt.timestep;
-  per_rate_ = stepsPer(physics_hz, config.rate_rate_hz, "rates_hz.rate");
-  per_attitude_ = stepsPer(physics_hz, config.attitude_rate_hz, "rates_hz.attitude");
-  per_position_ = stepsPer(physics_hz, config.position_rate_hz, "rates_hz.position");
+  per_rate_ = stepsPerTick(m, config.rate_rate_hz, "controller rates_hz.rate =");
+  per_attitude_ = stepsPerTick(m, config.attitude_rate_hz, "controller rates_hz.attitude =");
+  per_position_ = stepsPerTick(m, config.position_rate_hz, "controller rates_hz.position =");
 }
 
 void FlightLoop::setDivergenceLimits(double tilt_rad, double speed_m_s) {

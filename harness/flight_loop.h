@@ -26,6 +26,11 @@ struct FlightConfig {
   void validate() const;
 };
 
+// Physics steps per tick of a loop running at `rate_hz` (the controller stages, the camera).
+// InputError "<what> <rate> Hz does not divide the physics rate of <physics> Hz" when it does not
+// divide the physics rate; `what` names the setting, e.g. "--record-rate:".
+int stepsPerTick(const mjModel* m, double rate_hz, const std::string& what);
+
 class FlightLoop {
  public:
   // InputError when the loop rates do not divide the physics rate.

@@ -107,7 +107,6 @@ class VoPipeline {
     changed_.wait(lock, [&] { return queue_.size() < kQueueCapacity || error_; });
     rethrowLocked();
     queue_.push_back(Job{std::move(frame), keep_image});
-    ++submitted_;
     changed_.notify_all();
   }
 
@@ -192,7 +191,6 @@ class VoPipeline {
   std::condition_variable changed_;
   std::deque<Job> queue_;
   std::vector<Done> done_;
-  std::size_t submitted_ = 0;
   bool stop_ = false;
   std::exception_ptr error_;
   std::atomic<bool> failed_for_good_{false};
@@ -200,19 +198,6 @@ class VoPipeline {
 
 // Height above the landed pose from which a touch of the ground is a crash.
 constexpr double kLiftOffM = 0.1;
-
-int stepsPerFrame(const mjModel* m, double camera_rate_hz) {
-  const double physics_hz = 1.0 / m->opt.timestep;
-  const double ratio = physics_hz / camera_rate_hz;
-  const int n = std::isfinite(ratio) ? static_cast<int>(std::lround(ratio)) : 0;
-  if (n < 1 || std::abs(ratio - n) > 1e-6) {
-    std::ostringstream msg;
-    msg << "trial.camera_rate_hz = " << camera_rate_hz << " does not divide the physics rate of " << physics_hz
-        << " Hz (e.g. 10, 20, 25, 50)";
-    throw InputError(msg.str());
-  }
-  return n;
-}
 
 // The other party of a contact involving the vehicle, or -1 when the contact does not involve it.
 int contactPartner(const mjModel* m, const mjContact& c, int vehicle_root) {
@@ -276,7 +261,7 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   landed.p_WB.z() = scenario.scene.bounds_min_m.z() + kLandedHeightM;
   setVehiclePose(model.get(), data.get(), ids, landed);
   FlightLoop loop(model.get(), data.get(), ids, scenario.controller);
-  const int steps_per_frame = stepsPerFrame(model.get(), cfg.camera_rate_hz);
+  const int steps_per_frame = stepsPerTick(model.get(), cfg.camera_rate_hz, "trial.camera_rate_hz =");
   const FlightTimeline timeline = flightTimeline(loop, trajectory, cfg.flight);
   result.planned_flight_s = timeline.end_s;
 
@@ -406,7 +391,8 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
 
   // What decided the outcome, most severe first.
   const Eigen::Vector3d final_p = result.flight.log.empty() ? Eigen::Vector3d::Zero() : loop.state().p_WB;
-  const double to_goal = (final_p - scenario.scene.goal.p_WB).norm();
+  result.final_distance_to_goal_m = (final_p - scenario.scene.goal.p_WB).norm();
+  const double to_goal = result.final_distance_to_goal_m;
   std::ostringstream why;
   why.precision(2);
   why << std::fixed;
@@ -450,10 +436,6 @@ TrialScores scoreTrial(const TrialResult& result) {
   s.trajectory_length_m = result.plan.trajectory.length_m;
   for (std::size_t i = 1; i < result.flight.log.size(); ++i) {
     s.path_length_m += (result.flight.log[i].state.p_WB - result.flight.log[i - 1].state.p_WB).norm();
-  }
-  if (!result.flight.log.empty() && result.plan.report.plan.chosen >= 0) {
-    s.final_distance_to_goal_m =
-        (result.flight.log.back().state.p_WB - result.plan.report.plan.path.back().p_WB).norm();
   }
 
   std::vector<vo::PosePair> pairs;
@@ -514,7 +496,7 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["planned_length_m"] = scores.planned_length_m;
   j["trajectory_length_m"] = scores.trajectory_length_m;
   j["goal_error_m"] = orNull(scores.goal_error_m);
-  j["final_distance_to_goal_m"] = scores.final_distance_to_goal_m;
+  j["final_distance_to_goal_m"] = result.final_distance_to_goal_m;
   j["ate_rmse_m"] = scores.ate_rmse_m;
   j["ate_anchored_rmse_m"] = scores.ate_anchored_rmse_m;
   j["ate_max_m"] = scores.ate_max_m;

@@ -68,6 +68,7 @@ struct TrialResult {
   std::vector<TrialFrame> frames;  // in time order; after the first loss only while re-initialising
   std::optional<TrialEvent> vo_lost;
   std::optional<TrialEvent> collision;
+  double final_distance_to_goal_m = 0.0;  // true position at the end of the flight
   double sim_time_s = 0.0;
   double flight_wall_s = 0.0;
   double planned_flight_s = 0.0;
@@ -94,7 +95,6 @@ struct TrialScores {
   double planned_length_m = 0.0;    // the chosen planner path
   double trajectory_length_m = 0.0;
   std::optional<double> goal_error_m;  // |estimated - true| camera position at the last frame
-  double final_distance_to_goal_m = 0.0;
   double ate_rmse_m = 0.0;           // tracked frames, SE(3)-aligned
   double ate_anchored_rmse_m = 0.0;  // tracked frames, VO frame = true frame at the start
   double ate_max_m = 0.0;            // anchored
