@@ -8,6 +8,8 @@
 namespace tgnav::cli {
 
 void addRenderCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
+void addSweepCommand(CLI::App& app);
 void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);

@@ -8,6 +8,8 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <opencv2/core/utility.hpp>
 #include <sstream>
 
 #include "harness/cli.h"
@@ -45,6 +47,7 @@ struct TrialCliOptions {
   int frames = 0;
   std::string map;
   std::string map_cache;
+  int threads = 0;  // 0: as configured
 };
 
 // The output folder: refused when it holds anything unless --force; results are written into a
@@ -106,6 +109,16 @@ class OutputDir {
   bool committed_ = false;
 };
 
+// Caps the threads the trial uses (a sweep runs one trial per core): the planner's, OpenCV's and
+// llvmpipe's rasteriser threads (unless LP_NUM_THREADS is set), and one thread renders and
+// tracks in turn. The results do not depend on it.
+void limitThreads(int threads, harness::Scenario* scenario) {
+  scenario->planner.perception.threads = threads;
+  if (threads == 1) scenario->trial.pipeline = false;
+  cv::setNumThreads(threads);
+  setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), /*overwrite=*/0);
+}
+
 std::string voCsv(const harness::TrialResult& r) {
   std::ostringstream out;
   out.precision(6);
@@ -115,8 +128,8 @@ std::string voCsv(const harness::TrialResult& r) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
     const Eigen::Vector3d e = f.vo.X_WC.translation();
     out << f.vo.t_s << ',' << vo::toString(f.vo.status) << ',' << f.vo.features << ',' << f.vo.with_depth << ','
-        << f.vo.matches << ',' << f.vo.inliers << ',' << (f.vo.keyframe ? 1 : 0) << ',' << p.x() << ',' << p.y()
-        << ',' << p.z() << ',';
+        << f.vo.matches << ',' << f.vo.inliers << ',' << (f.vo.keyframe ? 1 : 0) << ',' << p.x() << ',' << p.y() << ','
+        << p.z() << ',';
     if (f.tracked()) {
       out << e.x() << ',' << e.y() << ',' << e.z();
     } else {
@@ -201,10 +214,11 @@ int runTrialCommand(const TrialCliOptions& opt) {
   harness::Scenario scenario = harness::loadScenario(opt.scenario, &overrides);
   if (opt.seed >= 0) scenario.seed = static_cast<std::uint64_t>(opt.seed);
   options.seed = scenario.seed;
+  if (opt.threads < 0) throw InputError("--threads: " + std::to_string(opt.threads) + " must be >= 1");
+  if (opt.threads > 0) limitThreads(opt.threads, &scenario);
 
   OutputDir dir(opt.out, opt.force);
-  const planner::FeatureMap map =
-      harness::loadSceneFeatureMap(scenario.scene, opt.map, opt.map_cache, "tgnav trial");
+  const planner::FeatureMap map = harness::loadSceneFeatureMap(scenario.scene, opt.map, opt.map_cache, "tgnav trial");
 
   g_interrupted.store(false);
   std::signal(SIGINT, onInterrupt);
@@ -271,6 +285,9 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_option("--set", opt->set,
                   "Override a setting of the resolved config, e.g. --set trial.state_source=vo "
                   "--set camera.width_px=320 (repeatable; keys as in DIR/config.yaml)");
+  cmd->add_option("--threads", opt->threads,
+                  "Use at most N threads (planner, OpenCV, renderer; 1 also renders and tracks in turn); "
+                  "results do not change. Default: as configured");
   cmd->add_flag("--force", opt->force, "Replace the results already in --out");
   cmd->add_option("--frames", opt->frames, "Also write frames.png: a strip of N onboard frames (0-64)");
   cmd->add_option("--map", opt->map, "Feature map folder from `tgnav map` (default: cached by content)");

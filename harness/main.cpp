@@ -55,6 +55,8 @@ int main(int argc, char** argv) {
   tgnav::cli::addMapCommand(app);
   tgnav::cli::addPlanCommand(app);
   tgnav::cli::addTrialCommand(app);
+  tgnav::cli::addSweepCommand(app);
+  tgnav::cli::addReportCommand(app);
   tgnav::cli::addVoCommand(app);
   try {
     app.parse(argc, argv);
