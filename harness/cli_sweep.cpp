@@ -27,6 +27,7 @@
 #include "harness/output.h"
 #include "harness/scenario.h"
 #include "harness/sweep.h"
+#include "harness/yaml_util.h"
 
 namespace tgnav::cli {
 
@@ -232,11 +233,14 @@ void tidy(const SweepDir& dir, const std::vector<SweepTrial>& trials, const std:
 
 // Builds each scene's feature map once, before the trials that share it start.
 void prebuildMaps(const std::vector<SweepTrial>& pending, const std::string& map_cache) {
-  std::map<std::string, fs::path> scenes;
-  for (const SweepTrial& t : pending) scenes.emplace(t.scene, t.scenario);
+  std::map<std::string, const SweepTrial*> scenes;  // a trial of each scene
+  for (const SweepTrial& t : pending) scenes.emplace(t.scene, &t);
   const fs::path cache = map_cache.empty() ? harness::defaultCacheDir() : fs::path(map_cache);
-  for (const auto& [scene, scenario] : scenes) {
-    const harness::Scenario s = harness::loadScenario(scenario);
+  for (const auto& [scene, trial] : scenes) {
+    std::vector<std::string> set;  // the trial's own settings: one may name another scene
+    for (const auto& [key, value] : trial->set) set.push_back(key + "=" + value);
+    const harness::YamlDoc overrides = harness::YamlDoc::fromOverrides(set);
+    const harness::Scenario s = harness::loadScenario(trial->scenario, &overrides);
     bool told = false;
     harness::cachedFeatureMap(s.scene, harness::MapBuildConfig{}, cache, [&](int done, int total) {
       if (!told) {
@@ -321,16 +325,33 @@ int defaultJobs() {
   return n == 0 ? 1 : static_cast<int>(n);
 }
 
-void printProgress(bool tty, int done, int total, int running, double elapsed_s, int done_now, int todo_now) {
-  if (!tty) return;
+// A running trial: which, and since when.
+struct Running {
+  std::size_t trial;
+  std::chrono::steady_clock::time_point since;
+};
+
+// The ETA: the mean wall time of this run's finished trials for each queued trial, less what the
+// running ones have already spent, shared among the jobs.
+std::string eta(const std::map<pid_t, Running>& running, std::size_t queued, double finished_s, int finished,
+                int jobs) {
+  if (finished == 0) return "--";
+  const double mean = finished_s / finished;
+  double left = mean * static_cast<double>(queued);
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& [pid, r] : running) {
+    left += std::max(0.0, mean - std::chrono::duration<double>(now - r.since).count());
+  }
+  return duration(left / std::max(1, jobs));
+}
+
+void printProgress(int done, int total, std::size_t running, double elapsed_s, const std::string& eta) {
   const int width = 30;
   const int filled = total > 0 ? width * done / total : width;
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(width, '.');
-  std::string eta = "--";
-  if (done_now > 0) eta = duration(elapsed_s / done_now * (todo_now - done_now));
-  std::fprintf(stderr, "\r\033[Ktgnav sweep: [%s] %d/%d done, %d running, %s elapsed, ETA %s", bar.c_str(), done, total,
-               running, duration(elapsed_s).c_str(), eta.c_str());
+  std::fprintf(stderr, "\r\033[Ktgnav sweep: [%s] %d/%d done, %zu running, %s elapsed, ETA %s", bar.c_str(), done,
+               total, running, duration(elapsed_s).c_str(), eta.c_str());
 }
 
 int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<SweepTrial>& trials,
@@ -361,7 +382,8 @@ int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
 
-  std::map<pid_t, std::size_t> running;  // pid -> trial index
+  std::map<pid_t, Running> running;
+  double finished_s = 0.0;  // wall time of this run's finished trials
   std::vector<std::string> failures;
   std::size_t next = 0;
   int done_now = 0;
@@ -373,19 +395,21 @@ int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
     if (sig == 0) {
       while (next < todo.size() && static_cast<int>(running.size()) < jobs) {
         const SweepTrial& t = trials[todo[next]];
-        running.emplace(spawnTrial(exe, childArguments(dir, t, opt.map_cache), dir.logFile(t)), todo[next]);
+        const pid_t pid = spawnTrial(exe, childArguments(dir, t, opt.map_cache), dir.logFile(t));
+        running.emplace(pid, Running{todo[next], std::chrono::steady_clock::now()});
         ++next;
       }
     } else if (!forwarded) {
       // Ctrl-C reached the trials too (one process group); a SIGTERM for the sweep is passed on.
       if (sig == SIGTERM) {
-        for (const auto& [pid, i] : running) kill(pid, SIGTERM);
+        for (const auto& [pid, r] : running) kill(pid, SIGTERM);
       }
       forwarded = true;
     }
     if (running.empty()) break;
-    printProgress(tty, done, total, static_cast<int>(running.size()), elapsed(), done_now,
-                  static_cast<int>(todo.size()));
+    if (tty)
+      printProgress(done, total, running.size(), elapsed(),
+                    eta(running, todo.size() - next, finished_s, done_now, jobs));
     int wstatus = 0;
     const pid_t pid = waitpid(-1, &wstatus, WNOHANG);
     if (pid <= 0) {
@@ -394,7 +418,8 @@ int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
     }
     const auto it = running.find(pid);
     if (it == running.end()) continue;
-    const std::size_t i = it->second;
+    const std::size_t i = it->second.trial;
+    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - it->second.since).count();
     running.erase(it);
     const SweepTrial& t = trials[i];
     folders[i] = harness::inspectTrialFolder(t, dir.trialDir(t));
@@ -402,6 +427,7 @@ int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
     if (folders[i].state == TrialState::kDone) {
       ++done;
       ++done_now;
+      finished_s += took;
       dir.writeIndex(trials);
       const nlohmann::json& m = folders[i].metrics;
       std::string goal =

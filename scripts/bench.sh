@@ -3,8 +3,9 @@
 # with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
 # the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
 # storage and gallery with every planner (results/bench/plans/), which also times trajectory
-# generation on the chosen paths, and runs closed-loop trials (results/bench/trials/) for their
-# wall time, real-time factor and peak memory.
+# generation on the chosen paths, runs closed-loop trials (results/bench/trials/) for their
+# wall time, real-time factor and peak memory, and the smoke sweep with --jobs 1 and --jobs 2
+# (results/bench/sweep-jobs*/) for the sweep throughput.
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -54,6 +55,16 @@ for size in 640x480 320x240; do
     --out "$out/trials/storage-proposed-$size" >&2
 done
 
+# Sweep throughput: the smoke sweep (6 trials, each single-threaded) one and two at a time.
+for jobs in 1 2; do
+  rm -rf "$out/sweep-jobs$jobs"
+  t0=$(date +%s.%N)
+  "$build/harness/tgnav" sweep --sweep "$root/configs/sweeps/smoke.yaml" --jobs "$jobs" \
+    --out "$out/sweep-jobs$jobs" >&2
+  t1=$(date +%s.%N)
+  echo "$t0 $t1" >"$out/sweep-jobs$jobs/elapsed"
+done
+
 sha=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
 /usr/bin/python3 - "$out" "$sha" <<'PY'
 import json, os, socket, sys, datetime
@@ -80,6 +91,17 @@ for run in sorted(os.listdir(trials)) if os.path.isdir(trials) else []:
     m = json.load(open(os.path.join(trials, run, "metrics.json")))
     for figure in ("wall_time_s", "flight_wall_s", "real_time_factor", "peak_rss_mb"):
         rows.append({"benchmark": f"trial/{run}", "figure": figure, "value": m["timing"][figure]})
+per_min = {}
+for jobs in (1, 2):
+    elapsed = os.path.join(out, f"sweep-jobs{jobs}", "elapsed")
+    if not os.path.exists(elapsed):
+        continue
+    t0, t1 = map(float, open(elapsed).read().split())
+    trials = sum(1 for _ in open(os.path.join(out, f"sweep-jobs{jobs}", "index.csv"))) - 1
+    per_min[jobs] = 60.0 * trials / (t1 - t0)
+    rows.append({"benchmark": f"sweep/smoke/jobs{jobs}", "figure": "trials_per_min", "value": per_min[jobs]})
+if len(per_min) == 2:
+    rows.append({"benchmark": "sweep/smoke/jobs2_vs_jobs1", "figure": "speedup", "value": per_min[2] / per_min[1]})
 for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "bench.json"):
     data = json.load(open(os.path.join(out, name)))
     for b in data["benchmarks"]:
