@@ -512,16 +512,22 @@ std::vector<std::string> slurmActive(const SweepDir& dir) {
   return lines;
 }
 
-int runSlurm(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<SweepTrial>& trials,
-             const std::vector<TrialFolder>& folders) {
+// Refuses to touch a sweep whose Slurm tasks are still queued or running (they write into it
+// without the sweep's lock): checked before anything in DIR is tidied, whatever the backend.
+void refuseWhileSlurmRuns(const SweepDir& dir) {
+  if (!fs::exists(dir.path() / "slurm" / "jobs.txt")) return;
   const std::vector<std::string> active = slurmActive(dir);
   if (!active.empty()) {
     throw InputError("--out: " + dir.path().string() + ": " + std::to_string(active.size()) +
                      " tasks of this sweep are still queued or running in Slurm (job " +
                      active.front().substr(0, active.front().find('_')) +
                      "); wait for them (tgnav sweep --status --out DIR) or cancel them (scancel --name=" +
-                     jobName(dir) + ") before resubmitting");
+                     jobName(dir) + ") before running it again");
   }
+}
+
+int runSlurm(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<SweepTrial>& trials,
+             const std::vector<TrialFolder>& folders) {
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < trials.size(); ++i) {
     if (folders[i].state != TrialState::kDone) todo.push_back(i);
@@ -661,6 +667,7 @@ int runSweepCommand(const SweepCliOptions& opt) {
                         "tgnav sweep: " + dir.path().string() +
                             " is locked (another sweep, or the trials of a killed one still stopping); waiting...");
   prepareFolder(dir, sweep);
+  refuseWhileSlurmRuns(dir);
   std::vector<TrialFolder> folders = dir.inspect(sweep.trials);
   tidy(dir, sweep.trials, folders);
   folders = dir.writeIndex(sweep.trials);
