@@ -105,7 +105,9 @@ class FolderLock {
 // The sweep folder: its trials (from the manifest), their folders' states and the index.
 class SweepDir {
  public:
-  explicit SweepDir(fs::path dir) : dir_(fs::absolute(std::move(dir)).lexically_normal()) {
+  // Symbolic links resolved: the Slurm job name is a hash of this path, and a task sees DIR as
+  // its working directory.
+  explicit SweepDir(const fs::path& dir) : dir_(fs::weakly_canonical(fs::absolute(dir))) {
     if (!dir_.has_filename()) dir_ = dir_.parent_path();
   }
   const fs::path& path() const { return dir_; }
