@@ -16,6 +16,10 @@ void addPlanCommand(CLI::App& app);
 void addTrialCommand(CLI::App& app);
 void addVoCommand(CLI::App& app);
 
+// An error message on one line: trailing newlines dropped, inner ones become "; " (library and
+// tool messages may span several).
+std::string oneLine(std::string text);
+
 // Parses "a,b,c" into exactly `count` finite numbers; InputError naming `option` otherwise.
 std::vector<double> parseNumbers(const std::string& text, std::size_t count, const std::string& option,
                                  const std::string& form);

@@ -25,11 +25,6 @@ struct ReportCliOptions {
   bool no_plots = false;
 };
 
-std::string oneLine(std::string text) {
-  for (char& c : text) c = c == '\n' ? ' ' : c;
-  return text;
-}
-
 // The scene backgrounds, each from the first trial of its scene, in order of appearance; with
 // --no-map only their names (figure 3 then autoscales and has no start or goal marker).
 std::vector<harness::SceneBackground> backgrounds(const harness::SweepIndex& sweep, const fs::path& report_dir,

@@ -11,7 +11,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -26,6 +25,7 @@
 #include "harness/map_cache.h"
 #include "harness/output.h"
 #include "harness/scenario.h"
+#include "harness/shell.h"
 #include "harness/sweep.h"
 #include "harness/yaml_util.h"
 
@@ -469,27 +469,6 @@ int runLocal(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
 
 // ---- Slurm -------------------------------------------------------------------------------------
 
-struct Shell {
-  int rc = -1;
-  std::string output;
-};
-Shell shell(const std::string& command) {
-  Shell r;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe) != nullptr) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  while (!r.output.empty() && (r.output.back() == '\n' || r.output.back() == ' ')) r.output.pop_back();
-  return r;
-}
-
-std::string oneLine(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  return s;
-}
-
 // The job name of the sweep's arrays: unique to its folder, so squeue finds them by name.
 std::string jobName(const SweepDir& dir) {
   std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
@@ -501,7 +480,7 @@ std::string jobName(const SweepDir& dir) {
 
 // Tasks of the sweep's job arrays still queued or running, as "JOBID_TASK STATE" lines.
 std::vector<std::string> slurmActive(const SweepDir& dir) {
-  const Shell q = shell("squeue -h -r --name=" + jobName(dir) + " -o '%i %T'");
+  const harness::CommandResult q = harness::runCommand("squeue -h -r --name=" + jobName(dir) + " -o '%i %T'");
   if (q.rc != 0) {
     throw InputError("squeue failed (exit " + std::to_string(q.rc) + "): " + oneLine(q.output) +
                      "; is Slurm reachable from here (SLURM_CONF)?");
@@ -586,7 +565,7 @@ int runSlurm(const SweepCliOptions& opt, const SweepDir& dir, const std::vector<
   cmd += " " + harness::shellWord(script.string());
   std::fprintf(stderr, "tgnav sweep: submitting %zu trials (at most %d at once): %s\n", pending.size(), jobs,
                cmd.c_str());
-  const Shell r = shell(cmd);
+  const harness::CommandResult r = harness::runCommand(cmd);
   // sbatch --parsable prints "JOBID" or "JOBID;CLUSTER" first; with --wait it returns the
   // array's exit code once every task has ended.
   const std::string first = r.output.substr(0, r.output.find('\n'));

@@ -31,10 +31,6 @@ std::vector<double> parseNumbers(const std::string& text, std::size_t count, con
   return values;
 }
 
-}  // namespace tgnav::cli
-
-namespace {
-// Errors are one line: library messages (MuJoCo's, yaml-cpp's) may span several.
 std::string oneLine(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
   for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) {
@@ -42,7 +38,8 @@ std::string oneLine(std::string text) {
   }
   return text;
 }
-}  // namespace
+
+}  // namespace tgnav::cli
 
 int main(int argc, char** argv) {
   CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
@@ -66,10 +63,10 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   } catch (const tgnav::InputError& e) {
-    std::fprintf(stderr, "tgnav: error: %s\n", oneLine(e.what()).c_str());
+    std::fprintf(stderr, "tgnav: error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "tgnav: internal error: %s\n", oneLine(e.what()).c_str());
+    std::fprintf(stderr, "tgnav: internal error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
     return 1;
   }
   return 0;

@@ -1,9 +1,6 @@
 #include "harness/report.h"
 
-#include <sys/wait.h>
-
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -18,7 +15,7 @@
 #include "harness/map_cache.h"
 #include "harness/output.h"
 #include "harness/scenario.h"
-#include "harness/sweep.h"
+#include "harness/shell.h"
 #include "harness/topdown.h"
 
 namespace tgnav::harness {
@@ -584,16 +581,10 @@ PlotRun runPlotScript(const PlotTools& tools, const fs::path& report_dir) {
   const fs::path& script = tools.script;
   PlotRun run;
   const std::string command =
-      shellWord(python) + " " + shellWord(script.string()) + " " + shellWord(report_dir.string()) + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) {
-    run.error = "cannot start " + python;
-    return run;
-  }
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
-  const int status = pclose(pipe);
-  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+      shellWord(python) + " " + shellWord(script.string()) + " " + shellWord(report_dir.string());
+  const CommandResult result = runCommand(command);
+  run.output = result.output;
+  if (result.rc == 0) {
     run.ok = true;
     return run;
   }
@@ -606,7 +597,7 @@ PlotRun runPlotScript(const PlotTools& tools, const fs::path& report_dir) {
   const std::string prefix = script.filename().string() + ": error: ";
   if (last.compare(0, prefix.size(), prefix) == 0) last.erase(0, prefix.size());
   run.error =
-      last.empty() ? python + " " + script.string() + " failed (exit status " + std::to_string(status) + ")" : last;
+      last.empty() ? python + " " + script.string() + " failed (exit status " + std::to_string(result.rc) + ")" : last;
   return run;
 }
 

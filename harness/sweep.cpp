@@ -12,6 +12,7 @@
 #include "harness/plan_run.h"
 #include "harness/report.h"
 #include "harness/scenario.h"
+#include "harness/shell.h"
 #include "harness/yaml_util.h"
 
 namespace tgnav::harness {
@@ -313,16 +314,6 @@ std::string plain(std::string s) {
 }
 
 }  // namespace
-
-std::string shellWord(const std::string& s) {
-  const bool safe = !s.empty() && std::all_of(s.begin(), s.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || std::string("._-/=+:,@%").find(c) != std::string::npos;
-  });
-  if (safe) return s;
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 std::string manifestCsv(const std::vector<SweepTrial>& trials) {
   std::ostringstream out;

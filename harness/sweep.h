@@ -69,9 +69,6 @@ std::vector<std::string> trialArguments(const SweepTrial& trial, const std::file
 std::string manifestCsv(const std::vector<SweepTrial>& trials);
 std::vector<SweepTrial> parseManifest(const std::string& text, const std::string& file);
 
-// A word for a POSIX shell: bare when safe, else single-quoted.
-std::string shellWord(const std::string& s);
-
 // commands.txt: per trial a line "<id> trial --scenario ... --out trials/<id>", shell-quoted, to
 // be run in DIR. It pins the sweep down: a re-run must expand to the same commands.
 std::string commandsText(const std::vector<SweepTrial>& trials);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include "harness/shell.h"
 #include "tests/harness/test_util.h"
 
 namespace tgnav::harness {

@@ -1,9 +1,7 @@
 #pragma once
 // Helpers shared by the harness tests.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +10,7 @@
 #include "harness/errors.h"
 #include "harness/map_cache.h"
 #include "harness/quiet_stderr.h"
+#include "harness/shell.h"
 #include "planner/feature_map.h"
 
 namespace tgnav::test {
@@ -21,8 +20,8 @@ inline std::filesystem::path sourceDir() { return TGNAV_SOURCE_DIR; }
 // A fresh directory under the system temp dir, unique per test.
 inline std::filesystem::path tempDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  auto dir = std::filesystem::temp_directory_path() /
-             ("tgnav_" + std::string(info->test_suite_name()) + "_" + info->name());
+  auto dir =
+      std::filesystem::temp_directory_path() / ("tgnav_" + std::string(info->test_suite_name()) + "_" + info->name());
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
@@ -33,22 +32,9 @@ inline std::filesystem::path writeFile(const std::filesystem::path& path, const 
   return path;
 }
 
-struct CmdResult {
-  int rc = -1;
-  std::string output;  // stdout and stderr
-};
-
 // Runs a shell command line; its output (stderr included) and exit code.
-inline CmdResult runShell(const std::string& command) {
-  CmdResult run;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe) != nullptr) run.output += buf.data();
-  const int status = pclose(pipe);
-  run.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+using CmdResult = harness::CommandResult;
+inline CmdResult runShell(const std::string& command) { return harness::runCommand(command); }
 
 // The message of the InputError that `fn` throws ("" when it throws none).
 template <typename Fn>
