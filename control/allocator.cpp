@@ -26,22 +26,18 @@ ControlAllocator::ControlAllocator(const VehicleParams& vehicle) {
     effectiveness_.col(i) << moment, force.z();
     max_thrust_n_[i] = r.max_thrust_n;
   }
-  const Eigen::MatrixXd pinv =
-      effectiveness_.completeOrthogonalDecomposition().pseudoInverse();  // n x 4
+  const Eigen::MatrixXd pinv = effectiveness_.completeOrthogonalDecomposition().pseudoInverse();  // n x 4
 
   // PX4's normalisation: a full roll or pitch demand spans about +-1/sqrt(2) of the motor range
   // on a quad X, a full yaw demand saturates the most yaw-effective motor, full thrust makes
   // every motor full.
-  const double rp = std::sqrt(std::max(pinv.col(0).squaredNorm(), pinv.col(1).squaredNorm()) /
-                              (0.5 * n));
+  const double rp = std::sqrt(std::max(pinv.col(0).squaredNorm(), pinv.col(1).squaredNorm()) / (0.5 * n));
   scale_ << rp, rp, pinv.col(2).cwiseAbs().maxCoeff(), pinv.col(3).maxCoeff();
   mix_ = pinv;
   for (int j = 0; j < 4; ++j) mix_.col(j) /= scale_[j];
 }
 
-Eigen::VectorXd ControlAllocator::thrustsN(const Eigen::VectorXd& u) const {
-  return u.cwiseProduct(max_thrust_n_);
-}
+Eigen::VectorXd ControlAllocator::thrustsN(const Eigen::VectorXd& u) const { return u.cwiseProduct(max_thrust_n_); }
 
 Eigen::Vector4d ControlAllocator::wrenchOf(const ControlDemand& d) const {
   Eigen::Vector4d normalised;
@@ -57,8 +53,7 @@ ControlDemand ControlAllocator::achieved(const Eigen::VectorXd& u) const {
   return d;
 }
 
-double ControlAllocator::desaturationGain(const Eigen::VectorXd& u, const Eigen::VectorXd& dir,
-                                          double u_max) {
+double ControlAllocator::desaturationGain(const Eigen::VectorXd& u, const Eigen::VectorXd& dir, double u_max) {
   double k_min = 0.0;
   double k_max = 0.0;
   for (int i = 0; i < u.size(); ++i) {

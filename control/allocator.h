@@ -28,10 +28,8 @@ class ControlAllocator {
   ControlDemand achieved(const Eigen::VectorXd& u) const;
 
  private:
-  void desaturate(Eigen::VectorXd& u, const Eigen::VectorXd& direction, double u_max,
-                  bool reduce_only) const;
-  static double desaturationGain(const Eigen::VectorXd& u, const Eigen::VectorXd& direction,
-                                 double u_max);
+  void desaturate(Eigen::VectorXd& u, const Eigen::VectorXd& direction, double u_max, bool reduce_only) const;
+  static double desaturationGain(const Eigen::VectorXd& u, const Eigen::VectorXd& direction, double u_max);
 
   Eigen::MatrixXd effectiveness_;  // 4 x n: wrench per unit command
   Eigen::MatrixXd mix_;            // n x 4: u = mix_ * [roll, pitch, yaw, thrust] (normalised)

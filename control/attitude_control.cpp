@@ -1,10 +1,11 @@
-#include "control/check.h"
 #include "control/attitude_control.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "control/check.h"
 
 namespace tgnav::control {
 
@@ -29,8 +30,7 @@ AttitudeControl::AttitudeControl(const AttitudeControlConfig& config) : config_(
   gain_ = Eigen::Vector3d(config_.roll_p, config_.pitch_p, config_.yaw_p / config_.yaw_weight);
 }
 
-Eigen::Vector3d AttitudeControl::update(const Eigen::Quaterniond& q_in,
-                                        const AttitudeSetpoint& setpoint) const {
+Eigen::Vector3d AttitudeControl::update(const Eigen::Quaterniond& q_in, const AttitudeSetpoint& setpoint) const {
   const Eigen::Quaterniond q = q_in.normalized();
   Eigen::Quaterniond qd = setpoint.q_WB.normalized();
 

@@ -7,13 +7,25 @@
 namespace tgnav::control {
 
 struct AttitudeControlConfig {
-  double roll_p = 6.5;   // MC_ROLL_P [1/s]
-  double pitch_p = 6.5;  // MC_PITCH_P
-  double yaw_p = 2.8;    // MC_YAW_P
-  double yaw_weight = 0.4;  // MC_YAW_WEIGHT: yaw priority relative to roll/pitch
+  double roll_p = 6.5;                              // MC_ROLL_P [1/s]
+  double pitch_p = 6.5;                             // MC_PITCH_P
+  double yaw_p = 2.8;                               // MC_YAW_P
+  double yaw_weight = 0.4;                          // MC_YAW_WEIGHT: yaw priority relative to roll/pitch
   double max_roll_rate_rad_s = 3.839724354387525;   // MC_ROLLRATE_MAX 220 deg/s
   double max_pitch_rate_rad_s = 3.839724354387525;  // MC_PITCHRATE_MAX 220 deg/s
   double max_yaw_rate_rad_s = 3.490658503988659;    // MC_YAWRATE_MAX 200 deg/s
+
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("roll_p", roll_p);
+    a("pitch_p", pitch_p);
+    a("yaw_p", yaw_p);
+    a("yaw_weight", yaw_weight);
+    a("max_roll_rate_rad_s", max_roll_rate_rad_s);
+    a("max_pitch_rate_rad_s", max_pitch_rate_rad_s);
+    a("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
+  }
 
   void validate() const;
 };

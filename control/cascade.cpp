@@ -1,9 +1,9 @@
 #include "control/cascade.h"
 
-#include "control/check.h"
-
 #include <stdexcept>
 #include <string>
+
+#include "control/check.h"
 
 namespace tgnav::control {
 
@@ -11,10 +11,9 @@ void CascadeConfig::validate() const {
   position.validate();
   attitude.validate();
   rate.validate();
-  require(position_rate_hz > 0.0 && position_rate_hz <= attitude_rate_hz, "rates_hz.position",
-          position_rate_hz, "must be > 0 and <= rates_hz.attitude");
-  require(attitude_rate_hz <= rate_rate_hz, "rates_hz.attitude", attitude_rate_hz,
-          "must be <= rates_hz.rate");
+  require(position_rate_hz > 0.0 && position_rate_hz <= attitude_rate_hz, "rates_hz.position", position_rate_hz,
+          "must be > 0 and <= rates_hz.attitude");
+  require(attitude_rate_hz <= rate_rate_hz, "rates_hz.attitude", attitude_rate_hz, "must be <= rates_hz.rate");
   require(rate_rate_hz > 0.0, "rates_hz.rate", rate_rate_hz, "must be > 0");
 }
 
@@ -40,9 +39,7 @@ void Cascade::updatePosition(const VehicleState& state, const TrajectorySetpoint
   attitude_sp_ = thrustToAttitude(position_.update(state, setpoint, dt_s));
 }
 
-void Cascade::updateAttitude(const Eigen::Quaterniond& q_WB) {
-  rate_sp_ = attitude_.update(q_WB, attitude_sp_);
-}
+void Cascade::updateAttitude(const Eigen::Quaterniond& q_WB) { rate_sp_ = attitude_.update(q_WB, attitude_sp_); }
 
 Eigen::VectorXd Cascade::updateRate(const Eigen::Vector3d& w_B, double dt_s) {
   ControlDemand demand;

@@ -18,6 +18,20 @@ struct CascadeConfig {
   double attitude_rate_hz = 250.0;
   double rate_rate_hz = 500.0;
 
+  // Names every field once, for the harness's config files (a(key, field), nested structs and
+  // groups as mappings; harness/config/yaml_util.h): configs/controller.yaml.
+  template <typename Archive>
+  void visit(Archive& a) {
+    a.group("rates_hz", [&](auto& g) {
+      g("position", position_rate_hz);
+      g("attitude", attitude_rate_hz);
+      g("rate", rate_rate_hz);
+    });
+    a("position", position);
+    a("attitude", attitude);
+    a("rate", rate);
+  }
+
   void validate() const;
 };
 

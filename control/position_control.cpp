@@ -1,10 +1,11 @@
-#include "control/check.h"
 #include "control/position_control.h"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "control/check.h"
 
 namespace tgnav::control {
 
@@ -21,20 +22,18 @@ void PositionControlConfig::validate() const {
   require(max_vel_up_m_s > 0.0, "max_vel_up_m_s", max_vel_up_m_s, "must be > 0");
   require(max_vel_down_m_s > 0.0, "max_vel_down_m_s", max_vel_down_m_s, "must be > 0");
   require(tilt_max_rad > 0.0 && tilt_max_rad < 1.5, "tilt_max_rad", tilt_max_rad, "must be in (0, 1.5)");
-  require(thrust_min >= 0.0 && thrust_min < thrust_max, "thrust_min", thrust_min,
-          "must be in [0, thrust_max)");
+  require(thrust_min >= 0.0 && thrust_min < thrust_max, "thrust_min", thrust_min, "must be in [0, thrust_max)");
   require(thrust_max > 0.0 && thrust_max <= 1.0, "thrust_max", thrust_max, "must be in (0, 1]");
-  require(thrust_xy_margin >= 0.0 && thrust_xy_margin < thrust_max, "thrust_xy_margin",
-          thrust_xy_margin, "must be in [0, thrust_max)");
+  require(thrust_xy_margin >= 0.0 && thrust_xy_margin < thrust_max, "thrust_xy_margin", thrust_xy_margin,
+          "must be in [0, thrust_max)");
   require(vel_deriv_cutoff_hz > 0.0, "vel_deriv_cutoff_hz", vel_deriv_cutoff_hz, "must be > 0");
 }
 
-PositionControl::PositionControl(const PositionControlConfig& config, double hover_thrust,
-                                 double gravity_m_s2)
+PositionControl::PositionControl(const PositionControlConfig& config, double hover_thrust, double gravity_m_s2)
     : config_(config), hover_thrust_(hover_thrust), gravity_(gravity_m_s2) {
   config_.validate();
-  require(hover_thrust > config_.thrust_min && hover_thrust < config_.thrust_max, "hover_thrust",
-          hover_thrust, "must lie between thrust_min and thrust_max");
+  require(hover_thrust > config_.thrust_min && hover_thrust < config_.thrust_max, "hover_thrust", hover_thrust,
+          "must lie between thrust_min and thrust_max");
 }
 
 void PositionControl::reset() {
@@ -51,8 +50,7 @@ Eigen::Vector3d limitTilt(const Eigen::Vector3d& body_z, double max_tilt_rad) {
   if (tilt <= max_tilt_rad) return body_z;
   Eigen::Vector3d horizontal(body_z.x(), body_z.y(), 0.0);
   if (horizontal.norm() < 1e-12) horizontal = Eigen::Vector3d::UnitX();  // pointing down
-  return std::cos(max_tilt_rad) * Eigen::Vector3d::UnitZ() +
-         std::sin(max_tilt_rad) * horizontal.normalized();
+  return std::cos(max_tilt_rad) * Eigen::Vector3d::UnitZ() + std::sin(max_tilt_rad) * horizontal.normalized();
 }
 
 Eigen::Vector3d PositionControl::accelerationToThrust(const Eigen::Vector3d& acc_sp) const {
@@ -65,12 +63,11 @@ Eigen::Vector3d PositionControl::accelerationToThrust(const Eigen::Vector3d& acc
   return body_z * collective;
 }
 
-ThrustSetpoint PositionControl::update(const VehicleState& state, const TrajectorySetpoint& sp,
-                                       double dt_s) {
+ThrustSetpoint PositionControl::update(const VehicleState& state, const TrajectorySetpoint& sp, double dt_s) {
   // Position P plus velocity feed-forward; the horizontal limit applies to the sum but keeps
   // the feed-forward part first (ControlMath::constrainXY simplified to a norm clamp).
-  vel_sp_ = sp.v_WB + Eigen::Vector3d(config_.pos_p_xy, config_.pos_p_xy, config_.pos_p_z)
-                          .cwiseProduct(sp.p_WB - state.p_WB);
+  vel_sp_ =
+      sp.v_WB + Eigen::Vector3d(config_.pos_p_xy, config_.pos_p_xy, config_.pos_p_z).cwiseProduct(sp.p_WB - state.p_WB);
   const double vxy = vel_sp_.head<2>().norm();
   if (vxy > config_.max_vel_xy_m_s) vel_sp_.head<2>() *= config_.max_vel_xy_m_s / vxy;
   vel_sp_.z() = std::clamp(vel_sp_.z(), -config_.max_vel_down_m_s, config_.max_vel_up_m_s);
@@ -130,7 +127,7 @@ AttitudeSetpoint thrustToAttitude(const ThrustSetpoint& t) {
   // Heading: body x lies in the plane spanned by body z and the yaw direction.
   const Eigen::Vector3d y_c(-std::sin(t.yaw_rad), std::cos(t.yaw_rad), 0.0);
   Eigen::Vector3d body_x = y_c.cross(body_z);
-  if (body_z.z() < 0.0) body_x = -body_x;  // keep the nose forward when inverted
+  if (body_z.z() < 0.0) body_x = -body_x;                       // keep the nose forward when inverted
   if (body_x.norm() < 1e-9) body_x = Eigen::Vector3d::UnitX();  // thrust horizontal along y_c
   body_x.normalize();
   const Eigen::Vector3d body_y = body_z.cross(body_x);

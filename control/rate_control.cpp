@@ -1,11 +1,11 @@
 #include "control/rate_control.h"
 
-#include "control/check.h"
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "control/check.h"
 
 namespace tgnav::control {
 
@@ -13,8 +13,7 @@ void RateControlConfig::validate() const {
   const char* names[] = {"roll", "pitch", "yaw"};
   for (int a = 0; a < 3; ++a) {
     auto check = [&](double v, const char* what) {
-      require(v >= 0.0 && std::isfinite(v), std::string("rate.") + what + "." + names[a], v,
-              "must be finite and >= 0");
+      require(v >= 0.0 && std::isfinite(v), std::string("rate.") + what + "." + names[a], v, "must be finite and >= 0");
     };
     check(p[a], "p");
     check(i[a], "i");
@@ -35,8 +34,7 @@ void RateControl::reset() {
   saturation_ = Saturation{};
 }
 
-Eigen::Vector3d RateControl::update(const Eigen::Vector3d& rate_sp, const Eigen::Vector3d& w_B,
-                                    double dt_s) {
+Eigen::Vector3d RateControl::update(const Eigen::Vector3d& rate_sp, const Eigen::Vector3d& w_B, double dt_s) {
   if (has_prev_ && dt_s > 0.0) {
     const double alpha = dt_s / (dt_s + 1.0 / (2.0 * M_PI * config_.dterm_cutoff_hz));
     w_dot_ += alpha * ((w_B - w_prev_) / dt_s - w_dot_);
@@ -45,8 +43,8 @@ Eigen::Vector3d RateControl::update(const Eigen::Vector3d& rate_sp, const Eigen:
   has_prev_ = true;
 
   const Eigen::Vector3d error = rate_sp - w_B;
-  const Eigen::Vector3d torque = config_.p.cwiseProduct(error) + integral_ -
-                                 config_.d.cwiseProduct(w_dot_) + config_.ff.cwiseProduct(rate_sp);
+  const Eigen::Vector3d torque =
+      config_.p.cwiseProduct(error) + integral_ - config_.d.cwiseProduct(w_dot_) + config_.ff.cwiseProduct(rate_sp);
 
   for (int a = 0; a < 3; ++a) {
     double e = error[a];

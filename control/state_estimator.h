@@ -43,6 +43,17 @@ struct EstimatorConfig {
   double max_position_innovation_m = 1.0;  // VO poses further than this from the estimate are rejected
   double history_s = 1.0;                  // how old a fused measurement may be
 
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("accel_noise_m_s2", accel_noise_m_s2);
+    a("position_sigma_m", position_sigma_m);
+    a("attitude_gain", attitude_gain);
+    a("gyro_bias_gain", gyro_bias_gain);
+    a("max_position_innovation_m", max_position_innovation_m);
+    a("history_s", history_s);
+  }
+
   void validate() const;  // std::invalid_argument naming the field and value
 };
 

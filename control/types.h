@@ -10,7 +10,7 @@ struct VehicleState {
   Eigen::Vector3d p_WB = Eigen::Vector3d::Zero();  // position of B in W [m]
   Eigen::Vector3d v_WB = Eigen::Vector3d::Zero();  // velocity of B in W [m/s]
   Eigen::Quaterniond q_WB = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();   // body rates in B [rad/s]
+  Eigen::Vector3d w_B = Eigen::Vector3d::Zero();  // body rates in B [rad/s]
 };
 
 // One trajectory setpoint; velocity and acceleration are feed-forward terms.

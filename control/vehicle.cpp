@@ -1,9 +1,9 @@
 #include "control/vehicle.h"
 
-#include "control/check.h"
-
 #include <stdexcept>
 #include <string>
+
+#include "control/check.h"
 
 namespace tgnav::control {
 

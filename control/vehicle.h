@@ -6,10 +6,10 @@
 namespace tgnav::control {
 
 struct Rotor {
-  Eigen::Vector3d p_B = Eigen::Vector3d::Zero();  // thrust point relative to the centre of mass
+  Eigen::Vector3d p_B = Eigen::Vector3d::Zero();      // thrust point relative to the centre of mass
   Eigen::Vector3d axis_B = Eigen::Vector3d::UnitZ();  // thrust direction
-  int spin = 1;                    // +1 counter-clockwise seen from above, -1 clockwise
-  double yaw_moment_ratio_m = 0.0; // drag moment / thrust
+  int spin = 1;                                       // +1 counter-clockwise seen from above, -1 clockwise
+  double yaw_moment_ratio_m = 0.0;                    // drag moment / thrust
   double max_thrust_n = 0.0;
 };
 

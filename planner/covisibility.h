@@ -16,8 +16,15 @@
 namespace tgnav::planner {
 
 struct SegmentConfig {
-  double min_length_m = 0.5;         // l_min (Table I)
-  double covisibility_ratio = 0.5;   // eta (Table I)
+  double min_length_m = 0.5;        // l_min (Table I)
+  double covisibility_ratio = 0.5;  // eta (Table I)
+
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("min_length_m", min_length_m);
+    a("covisibility_ratio", covisibility_ratio);
+  }
 
   void validate() const;
 };

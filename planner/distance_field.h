@@ -32,8 +32,8 @@ class DistanceField {
  private:
   std::size_t padded(int ix, int iy) const { return static_cast<std::size_t>(iy + 1) * (grid_.width + 2) + ix + 1; }
   OccupancyGrid2D grid_;
-  std::vector<double> dist2_cells_;   // squared distance in cells, padded grid
-  std::vector<Eigen::Vector2i> site_; // nearest obstacle, grid coordinates
+  std::vector<double> dist2_cells_;    // squared distance in cells, padded grid
+  std::vector<Eigen::Vector2i> site_;  // nearest obstacle, grid coordinates
 };
 
 }  // namespace tgnav::planner

@@ -1,14 +1,14 @@
 #include "planner/feature_map.h"
 
-#include "planner/check.h"
-#include "planner/occupancy_grid.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include "planner/check.h"
+#include "planner/occupancy_grid.h"
 
 namespace tgnav::planner {
 
@@ -42,8 +42,10 @@ OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min
         for (double dy = -0.5 * resolution_m + 0.5 * step; dy < 0.5 * resolution_m && !occupied; dy += step) {
           for (double z = z_lo; z <= z_hi + 1e-9 && !occupied; z += map.resolution()) {
             const Eigen::Vector3d p(c.x() + dx, c.y() + dy, z);
-            if (map.isOccupied(p)) occupied = true;
-            else if (!map.isKnown(p)) unseen = true;
+            if (map.isOccupied(p))
+              occupied = true;
+            else if (!map.isKnown(p))
+              unseen = true;
           }
         }
       }
@@ -89,8 +91,8 @@ int FeatureMap::embedLandmarks(double max_shift_m) {
     const double dist = ray.norm();
     if (dist < 1e-6) continue;
     octomap::point3d hit;
-    const bool found = tree_->castRay(toOcto(lm.ref_kf_p_W), toOcto(ray), hit, /*ignoreUnknownCells=*/true,
-                                      dist + max_shift_m + res);
+    const bool found =
+        tree_->castRay(toOcto(lm.ref_kf_p_W), toOcto(ray), hit, /*ignoreUnknownCells=*/true, dist + max_shift_m + res);
     if (!found || (toEigen(hit) - lm.p_W).norm() > max_shift_m + 0.5 * std::sqrt(3.0) * res) continue;
     kept.push_back(lm);
     keys.push_back(tree_->coordToKey(hit));
@@ -128,8 +130,7 @@ std::vector<int> FeatureMap::visibleFrom(const Eigen::Vector3d& p_W, const Visib
 }
 
 std::vector<int> FeatureMap::inHorizontalFov(const Eigen::Vector3d& p_W, double yaw_rad,
-                                             const std::vector<int>& candidates,
-                                             const VisibilityConfig& config) const {
+                                             const std::vector<int>& candidates, const VisibilityConfig& config) const {
   std::vector<int> out;
   const double half_hfov = 0.5 * config.hfov_rad;
   for (int id : candidates) {
@@ -159,8 +160,8 @@ void FeatureMap::save(const std::filesystem::path& dir) const {
       hex += kHex[b & 15];
     }
     out << i << ',' << lm.p_W.x() << ',' << lm.p_W.y() << ',' << lm.p_W.z() << ',' << lm.observations << ','
-        << lm.ref_kf_p_W.x() << ',' << lm.ref_kf_p_W.y() << ',' << lm.ref_kf_p_W.z() << ',' << v.x() << ','
-        << v.y() << ',' << v.z() << ',' << hex << '\n';
+        << lm.ref_kf_p_W.x() << ',' << lm.ref_kf_p_W.y() << ',' << lm.ref_kf_p_W.z() << ',' << v.x() << ',' << v.y()
+        << ',' << v.z() << ',' << hex << '\n';
   }
   if (!out) throw std::runtime_error((dir / "landmarks.csv").string() + ": cannot write");
 }
@@ -189,7 +190,8 @@ FeatureMap FeatureMap::load(const std::filesystem::path& dir) {
     std::vector<std::string> f;
     while (std::getline(ss, field, ',')) f.push_back(field);
     if (f.size() != 12 || f[11].size() != 64) {
-      throw std::runtime_error(csv + ":" + std::to_string(line_no) + ": expected 12 columns with a 64-digit descriptor");
+      throw std::runtime_error(csv + ":" + std::to_string(line_no) +
+                               ": expected 12 columns with a 64-digit descriptor");
     }
     Landmark lm;
     double v[10];

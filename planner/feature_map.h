@@ -15,10 +15,10 @@
 namespace tgnav::planner {
 
 struct Landmark {
-  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();        // mean of its observations
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  // mean of its observations
   int observations = 1;
-  Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero(); // camera position that first saw it
-  std::array<std::uint8_t, 32> descriptor{};            // ORB, from the reference observation
+  Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero();  // camera position that first saw it
+  std::array<std::uint8_t, 32> descriptor{};             // ORB, from the reference observation
 };
 
 // Sensing model of the query (V(p) uses range and vertical FoV; yaw filters by horizontal FoV).
@@ -27,6 +27,15 @@ struct VisibilityConfig {
   double vfov_rad = 1.0472;  // 60 deg
   double min_range_m = 0.3;
   double max_range_m = 6.0;
+
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("hfov_rad", hfov_rad);
+    a("vfov_rad", vfov_rad);
+    a("min_range_m", min_range_m);
+    a("max_range_m", max_range_m);
+  }
 
   void validate() const;
 };
@@ -59,8 +68,7 @@ class FeatureMap {
   // whose surface voxel is the first occupied voxel on the line of sight. Sorted ascending.
   std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
   // The subset of `candidates` inside the horizontal FoV of a camera at p with yaw `yaw_rad`.
-  std::vector<int> inHorizontalFov(const Eigen::Vector3d& p_W, double yaw_rad,
-                                   const std::vector<int>& candidates,
+  std::vector<int> inHorizontalFov(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<int>& candidates,
                                    const VisibilityConfig& config) const;
 
   // map.bt (OctoMap binary) and landmarks.csv in `dir`; load() throws std::runtime_error naming

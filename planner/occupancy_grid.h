@@ -19,8 +19,7 @@ struct OccupancyGrid2D {
 
   OccupancyGrid2D() = default;
   OccupancyGrid2D(int w, int h, double res, const Eigen::Vector2d& origin)
-      : width(w), height(h), resolution_m(res), origin_m(origin),
-        occupied(static_cast<std::size_t>(w) * h, 0) {}
+      : width(w), height(h), resolution_m(res), origin_m(origin), occupied(static_cast<std::size_t>(w) * h, 0) {}
 
   bool inside(int ix, int iy) const { return ix >= 0 && iy >= 0 && ix < width && iy < height; }
   // Outside the grid counts as occupied.

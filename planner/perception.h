@@ -21,6 +21,13 @@ struct InformationConfig {
   double bearing_noise_rad = 1.0;  // sigma of eq. 5; 1 puts c_p on the scale of Table I's c_p,thr = 6
   double epsilon = 1e-2;           // log det regulariser: a blind pose scores 6 ln(1e-2) = -27.6
 
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("bearing_noise_rad", bearing_noise_rad);
+    a("epsilon", epsilon);
+  }
+
   void validate() const;
 };
 

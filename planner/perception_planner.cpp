@@ -36,8 +36,10 @@ std::vector<Pose4> headingPath(const std::vector<Eigen::Vector3d>& path, double 
   double yaw = start_yaw;
   for (std::size_t i = 0; i < path.size(); ++i) {
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (i + 1 < path.size()) d = path[i + 1] - path[i];
-    else if (i > 0) d = path[i] - path[i - 1];
+    if (i + 1 < path.size())
+      d = path[i + 1] - path[i];
+    else if (i > 0)
+      d = path[i] - path[i - 1];
     if (d.head<2>().norm() > 1e-9) yaw = std::atan2(d.y(), d.x());
     out.push_back({path[i], yaw});
   }
@@ -76,6 +78,33 @@ std::vector<ScoredSegment> scoreSegments(const std::vector<PathSegment>& segment
   return out;
 }
 
+// The config as the planners use it: one robot radius for the GVD slice and the pose graph.
+PerceptionPlannerConfig withRobotRadius(PerceptionPlannerConfig config) {
+  config.topo.robot_radius_m = config.robot_radius_m;
+  config.graph.robot_radius_m = config.robot_radius_m;
+  config.validate();
+  return config;
+}
+
+// What both planners start from (Sec. V-B): the homology classes on the slice at the start's
+// height, and one candidate per class with the class's H-signature and reference length.
+Plan classCandidates(const VoxelMap& voxels, const PerceptionPlannerConfig& config, const PlanRequest& request) {
+  Plan plan;
+  const double z = request.start.p_WB.z();
+  plan.flight_height_m = z;
+  const OccupancyGrid2D grid = voxels.slice(z - config.slice_half_height_m, z + config.slice_half_height_m);
+  const TopologicalPlanner topo(grid, config.topo);
+  plan.topo = topo.solve(request.start.p_WB.head<2>(), request.goal.p_WB.head<2>());
+  plan.status = plan.topo.status;
+  if (plan.status != PlanStatus::kSolved) return plan;
+  plan.candidates.resize(plan.topo.classes.size());
+  for (std::size_t i = 0; i < plan.candidates.size(); ++i) {
+    plan.candidates[i].h_signature = plan.topo.classes[i].h_signature;
+    plan.candidates[i].length_m = plan.topo.classes[i].length_m;
+  }
+  return plan;
+}
+
 }  // namespace
 
 void SelectionConfig::validate() const {
@@ -102,50 +131,25 @@ double selectionCost(double length_m, double shortest_m, double c_p_min, const S
   return config.distance_weight * extra + config.perception_weight * f;
 }
 
-PerceptionPlanner::PerceptionPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config)
-    : voxels_(voxels), config_(config) {
-  config_.topo.robot_radius_m = config_.robot_radius_m;
-  config_.graph.robot_radius_m = config_.robot_radius_m;
-  config_.validate();
-}
+ProposedPlanner::ProposedPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config)
+    : voxels_(voxels), config_(withRobotRadius(config)) {}
 
-PerceptionPlanReport PerceptionPlanner::solve(const Pose4& start, const Pose4& goal, PlannerKind kind,
-                                              std::uint64_t seed) const {
-  PerceptionPlanReport report;
-  const double z = start.p_WB.z();
-  report.flight_height_m = z;
-  const OccupancyGrid2D grid = voxels_.slice(z - config_.slice_half_height_m, z + config_.slice_half_height_m);
-  const TopologicalPlanner topo(grid, config_.topo);
-  report.topo = topo.solve(start.p_WB.head<2>(), goal.p_WB.head<2>());
-  Plan& plan = report.plan;
-  plan.status = report.topo.status;
-  if (report.topo.status != PlanStatus::kSolved) return report;
+Plan ProposedPlanner::solve(const PlanRequest& request) const {
+  Plan plan = classCandidates(voxels_, config_, request);
+  if (plan.status != PlanStatus::kSolved) return plan;
 
-  const std::size_t n = report.topo.classes.size();
-  plan.candidates.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    plan.candidates[i].h_signature = report.topo.classes[i].h_signature;
-    plan.candidates[i].length_m = report.topo.classes[i].length_m;
-  }
-  if (kind == PlannerKind::kAgnostic) {
-    for (std::size_t i = 0; i < n; ++i) {
-      plan.candidates[i].path = headingPath(lift(report.topo.classes[i].path, z), start.yaw_rad);
-    }
-    plan.chosen = report.topo.chosen;
-    plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
-    return report;
-  }
-
-  report.details.resize(n);
+  const double z = plan.flight_height_m;
+  const std::size_t n = plan.candidates.size();
+  plan.details.resize(n);
   auto evaluate = [&](std::size_t i) {
-    const std::vector<Eigen::Vector3d> path = lift(report.topo.classes[i].path, z);
-    ClassDetail& detail = report.details[i];
+    const std::vector<Eigen::Vector3d> path = lift(plan.topo.classes[i].path, z);
+    ClassDetail& detail = plan.details[i];
     detail.segments = extractSegments(
         path, config_.segments, [&](const Eigen::Vector3d& p) { return voxels_.visibleFrom(p, config_.visibility); },
         &detail.visibility_queries);
-    detail.graph = searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information,
-                                   config_.graph, config_.keep_start_yaw ? start.yaw_rad : std::nan(""),
-                                   classSeed(seed, i));
+    detail.graph =
+        searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information, config_.graph,
+                        config_.keep_start_yaw ? request.start.yaw_rad : std::nan(""), classSeed(request.seed, i));
     CandidatePath& c = plan.candidates[i];
     c.feasible = detail.graph.found;
     c.segments = scoreSegments(detail.segments, detail.graph);
@@ -181,10 +185,27 @@ PerceptionPlanReport PerceptionPlanner::solve(const Pose4& start, const Pose4& g
   }
   if (plan.chosen < 0) {
     plan.status = PlanStatus::kNoPath;
-    return report;
+    return plan;
   }
   plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
-  return report;
+  // Candidate i is class i's: its pose graph is sampled around that class's path.
+  plan.chosen_class = plan.chosen;
+  return plan;
+}
+
+AgnosticPlanner::AgnosticPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config)
+    : voxels_(voxels), config_(withRobotRadius(config)) {}
+
+Plan AgnosticPlanner::solve(const PlanRequest& request) const {
+  Plan plan = classCandidates(voxels_, config_, request);
+  if (plan.status != PlanStatus::kSolved) return plan;
+  for (std::size_t i = 0; i < plan.candidates.size(); ++i) {
+    plan.candidates[i].path = headingPath(lift(plan.topo.classes[i].path, plan.flight_height_m), request.start.yaw_rad);
+  }
+  plan.chosen = plan.topo.chosen;
+  plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
+  plan.chosen_class = plan.chosen;
+  return plan;
 }
 
 }  // namespace tgnav::planner

@@ -1,10 +1,11 @@
 #pragma once
-// The paper's planner (Alg. 1) and its perception-agnostic baseline on a feature map.
+// The paper's planner (Alg. 1) and its perception-agnostic baseline on a feature map, both
+// behind the Planner interface (planner.h) and both starting from the same GVD homology classes
+// on the flight-height slice (Sec. V-B), one candidate per class in the classes' order.
 //
-// Proposed: GVD homology classes on the flight-height slice (Sec. V-B), then per class, in
-// parallel: path segments by co-visibility (Sec. V-C), the 4-DoF pose graph and its exact DAG
-// search (Sec. V-D), and the selection cost (Sec. V-E, eq. 9). Agnostic (AP): the shortest
-// class, yaw along the direction of travel.
+// Proposed: per class, in parallel: path segments by co-visibility (Sec. V-C), the 4-DoF pose
+// graph and its exact DAG search (Sec. V-D), and the selection cost (Sec. V-E, eq. 9). Agnostic
+// (AP): the shortest class, yaw along the direction of travel.
 //
 // Eq. 9 as printed, q = eta_d (d/d_min - 1) - eta_p f(c_p,min - c_p,thr) with f(x) = 1/(1+e^x),
 // rewards a class whose weakest segment has LITTLE information (f grows as c_p,min falls), and
@@ -14,13 +15,9 @@
 // a class pays up to eta_p when its weakest segment falls below c_p,thr, and eta_d per unit of
 // relative extra length. With Table I (eta_d 0.2, eta_p 1.5) a fully feature-poor class loses
 // to a feature-rich one up to 1 + 1.5/0.2 = 8.5 times its length.
-#include <cstdint>
-#include <vector>
-
 #include "planner/covisibility.h"
-#include "planner/feature_map.h"
 #include "planner/perception.h"
-#include "planner/plan.h"
+#include "planner/planner.h"
 #include "planner/pose_graph.h"
 #include "planner/topological_planner.h"
 #include "planner/voxel_map.h"
@@ -28,25 +25,49 @@
 namespace tgnav::planner {
 
 struct SelectionConfig {
-  double c_p_threshold = 6.0;     // c_p,thr (Table I)
-  double distance_weight = 0.2;   // eta_d
-  double perception_weight = 1.5; // eta_p
+  double c_p_threshold = 6.0;      // c_p,thr (Table I)
+  double distance_weight = 0.2;    // eta_d
+  double perception_weight = 1.5;  // eta_p
+
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("c_p_threshold", c_p_threshold);
+    a("distance_weight", distance_weight);
+    a("perception_weight", perception_weight);
+  }
 
   void validate() const;
 };
 
 struct PerceptionPlannerConfig {
-  double robot_radius_m = 0.3;        // clearance in the GVD slice and for every 4-DoF node and edge
-  double slice_half_height_m = 0.3;   // the GVD slice spans flight height +- this
-  TopoPlannerConfig topo;             // its robot_radius_m is replaced by the one above
+  double robot_radius_m = 0.3;       // clearance in the GVD slice and for every 4-DoF node and edge
+  double slice_half_height_m = 0.3;  // the GVD slice spans flight height +- this
+  TopoPlannerConfig topo;            // its robot_radius_m is replaced by the one above
   VisibilityConfig visibility;
   InformationConfig information;
   SegmentConfig segments;
-  PoseGraphConfig graph;              // its robot_radius_m is replaced by the one above
+  PoseGraphConfig graph;  // its robot_radius_m is replaced by the one above
   SelectionConfig selection;
-  bool keep_start_yaw = false;        // false: the MAV may turn on the spot before it sets off,
-                                      // so the first pose's yaw is searched like the others
-  int threads = 0;                    // classes evaluated in parallel; 0 = one per core
+  bool keep_start_yaw = false;  // false: the MAV may turn on the spot before it sets off,
+                                // so the first pose's yaw is searched like the others
+  int threads = 0;              // classes evaluated in parallel; 0 = one per core
+
+  // Names every field once, for the harness's config files (a(key, field), nested configs as
+  // mappings; harness/config/yaml_util.h): configs/planner.yaml.
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("robot_radius_m", robot_radius_m);
+    a("slice_half_height_m", slice_half_height_m);
+    a("keep_start_yaw", keep_start_yaw);
+    a("threads", threads);
+    a("topology", topo);
+    a("visibility", visibility);
+    a("information", information);
+    a("segments", segments);
+    a("pose_graph", graph);
+    a("selection", selection);
+  }
 
   void validate() const;
 };
@@ -54,27 +75,33 @@ struct PerceptionPlannerConfig {
 // Eq. 9 with the intended sign (see above). The smallest wins.
 double selectionCost(double length_m, double shortest_m, double c_p_min, const SelectionConfig& config);
 
-struct ClassDetail {
-  std::vector<PathSegment> segments;
-  PoseGraphResult graph;
-  int visibility_queries = 0;
-};
-
-struct PerceptionPlanReport {
-  Plan plan;
-  TopoPlan topo;                     // classes in the same order as plan.candidates
-  std::vector<ClassDetail> details;  // per class (proposed only)
-  double flight_height_m = 0.0;
-};
-
-enum class PlannerKind { kProposed, kAgnostic };
-
-class PerceptionPlanner {
+// Alg. 1. Candidates: every class's best 4-DoF path (infeasible where the pose graph finds none),
+// with its eq. 9 cost; the cheapest is chosen. details: per class. chosen_class = chosen.
+class ProposedPlanner final : public Planner {
  public:
-  PerceptionPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config);
+  // Keeps a reference to `voxels`: it must outlive the planner.
+  ProposedPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config);
 
-  // Plans at the start's height. Deterministic for a given seed, whatever the number of threads.
-  PerceptionPlanReport solve(const Pose4& start, const Pose4& goal, PlannerKind kind, std::uint64_t seed) const;
+  // Deterministic for a given seed, whatever the number of threads.
+  Plan solve(const PlanRequest& request) const override;
+  const char* name() const override { return toString(PlannerKind::kProposed); }
+
+ private:
+  const VoxelMap& voxels_;
+  PerceptionPlannerConfig config_;
+};
+
+// AP. Candidates: every class's shortened path with the yaw along the direction of travel, no
+// perception figures; the shortest (TopoPlan::chosen) is chosen. chosen_class = chosen. The seed
+// is not used. Only the robot radius, the slice and the topology of the config are read, but all
+// of it is validated (one config for both planners).
+class AgnosticPlanner final : public Planner {
+ public:
+  // Keeps a reference to `voxels`: it must outlive the planner.
+  AgnosticPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config);
+
+  Plan solve(const PlanRequest& request) const override;
+  const char* name() const override { return toString(PlannerKind::kAgnostic); }
 
  private:
   const VoxelMap& voxels_;

@@ -35,7 +35,9 @@ void PoseGraphConfig::validate() const {
   require(yaw_samples >= 1, "yaw_samples", yaw_samples, "must be >= 1");
   require(yaw_rate_limit_rad_s >= 0.0, "yaw_rate_limit_rad_s", yaw_rate_limit_rad_s, "must be >= 0");
   require(yaw_samples == 1 || 2.0 * M_PI / yaw_samples <= yaw_rate_limit_rad_s * time_step_s + 1e-9, "yaw_samples",
-          yaw_samples, "the yaw interval 2 pi / yaw_samples must not exceed yaw_rate_limit_rad_s * time_step_s, or the yaw could never change");
+          yaw_samples,
+          "the yaw interval 2 pi / yaw_samples must not exceed yaw_rate_limit_rad_s * time_step_s, or the yaw could "
+          "never change");
   require(distance_weight >= 0.0, "distance_weight", distance_weight, "must be >= 0");
   require(perception_weight >= 0.0, "perception_weight", perception_weight, "must be >= 0");
   require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
@@ -95,9 +97,10 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   // Every layer is one time step Ts (layers are at most v_nom * Ts apart): the yaw may change by
   // up to yaw_rate_limit * Ts between layers, at least one yaw interval by validate().
   const int max_yaw_steps =
-      yaws == 1 ? 0
-                : std::min(yaws / 2, static_cast<int>(std::floor(config.yaw_rate_limit_rad_s * config.time_step_s /
-                                                                     yaw_step + 1e-9)));
+      yaws == 1
+          ? 0
+          : std::min(yaws / 2,
+                     static_cast<int>(std::floor(config.yaw_rate_limit_rad_s * config.time_step_s / yaw_step + 1e-9)));
 
   // Landmarks of each segment's co-visible set, grouped by voxel once.
   std::vector<std::vector<WeightedPoint>> segment_points;

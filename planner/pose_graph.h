@@ -7,9 +7,9 @@
 // with yaw_samples yaws at equal intervals (the start's yaw among them). The first layer is the
 // start, the last the goal. Edges join consecutive layers only, where the straight move keeps
 // the robot radius from every 3D obstacle of the map and the yaw changes by at most
-// yaw_rate_limit * Ts (a layer is one time step; intervals are at most v_nom * Ts long). A node's information I(n) sums the bearing Fisher
-// information (eqs. 5-6) of the landmarks of its segment's co-visible set that are inside its
-// field of view. The path minimises (eq. 7)
+// yaw_rate_limit * Ts (a layer is one time step; intervals are at most v_nom * Ts long). A node's information I(n) sums
+// the bearing Fisher information (eqs. 5-6) of the landmarks of its segment's co-visible set that are inside its field
+// of view. The path minimises (eq. 7)
 //     lambda_d * c_d(P) - lambda_p * c_p(P),   c_p(P) = (1/N) sum_i log det I(n_i)   (eq. 8)
 // which splits into node and edge costs on a layered DAG: dynamic programming over the layers
 // in order finds the exact minimum in O(nodes + edges).
@@ -34,6 +34,20 @@ struct PoseGraphConfig {
   double distance_weight = 0.1;       // lambda_d
   double perception_weight = 1.0;     // lambda_p
   double robot_radius_m = 0.3;        // clearance of every node and edge
+
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("nominal_speed_mps", nominal_speed_mps);
+    a("time_step_s", time_step_s);
+    a("position_samples", position_samples);
+    a("sample_radius_m", sample_radius_m);
+    a("yaw_samples", yaw_samples);
+    a("yaw_rate_limit_rad_s", yaw_rate_limit_rad_s);
+    a("distance_weight", distance_weight);
+    a("perception_weight", perception_weight);
+    a("robot_radius_m", robot_radius_m);
+  }
 
   void validate() const;
 };
@@ -61,16 +75,16 @@ DagPath shortestLayeredPath(const LayeredDag& dag);
 
 struct PoseGraphResult {
   bool found = false;
-  std::vector<Pose4> path;       // one pose per layer
-  std::vector<double> layer_s;   // arclength of each layer along the reference path
-  std::vector<double> scores;    // log det I of each chosen node
+  std::vector<Pose4> path;         // one pose per layer
+  std::vector<double> layer_s;     // arclength of each layer along the reference path
+  std::vector<double> scores;      // log det I of each chosen node
   std::vector<int> layer_segment;  // segment index of each layer
-  double c_d = 0.0;              // length of `path`
-  double c_p = 0.0;              // eq. 8
-  double cost = 0.0;             // eq. 7
+  double c_d = 0.0;                // length of `path`
+  double c_p = 0.0;                // eq. 8
+  double cost = 0.0;               // eq. 7
   int nodes = 0;
   int edges = 0;
-  int blocked_layer = -1;        // when not found: first layer without a collision-free node, if any
+  int blocked_layer = -1;  // when not found: first layer without a collision-free node, if any
 };
 
 // `path` is the class's reference path (3D, start to goal), `segments` its segments (in order,

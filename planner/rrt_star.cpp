@@ -294,16 +294,41 @@ void RrtStarConfig::validate() const {
   require(distance_weight + perception_weight > 0.0, "distance_weight", distance_weight,
           "distance_weight + perception_weight must be > 0");
   require(std::isfinite(c_p_threshold), "c_p_threshold", c_p_threshold, "must be finite");
+  require(slice_half_height_m >= 0.0, "slice_half_height_m", slice_half_height_m, "must be >= 0");
   visibility.validate();
   information.validate();
+  topo.validate();
 }
 
 PerceptionRrtStar::PerceptionRrtStar(const VoxelMap& voxels, const RrtStarConfig& config)
     : voxels_(voxels), config_(config) {
+  config_.topo.robot_radius_m = config_.robot_radius_m;
   config_.validate();
 }
 
-Plan PerceptionRrtStar::solve(const Pose4& start, const Pose4& goal, std::uint64_t seed) const {
+Plan PerceptionRrtStar::solve(const PlanRequest& request) const {
+  Plan plan = searchTree(request.start, request.goal, request.seed);
+  // The classes after the search, which never sees them: the tree and its path are the same as
+  // without the labelling.
+  const double z = request.start.p_WB.z();
+  plan.flight_height_m = z;
+  const TopologicalPlanner topo(voxels_.slice(z - config_.slice_half_height_m, z + config_.slice_half_height_m),
+                                config_.topo);
+  plan.topo = topo.solve(request.start.p_WB.head<2>(), request.goal.p_WB.head<2>());
+  for (CandidatePath& c : plan.candidates) {
+    std::vector<Eigen::Vector2d> xy;
+    for (const Pose4& p : c.path) xy.push_back(p.p_WB.head<2>());
+    c.h_signature = topo.hSignature(xy);
+  }
+  if (plan.chosen < 0) return plan;
+  const std::vector<double>& h = plan.candidates[static_cast<std::size_t>(plan.chosen)].h_signature;
+  for (std::size_t i = 0; i < plan.topo.classes.size() && plan.chosen_class < 0; ++i) {
+    if (TopologicalPlanner::sameClass(h, plan.topo.classes[i].h_signature)) plan.chosen_class = static_cast<int>(i);
+  }
+  return plan;
+}
+
+Plan PerceptionRrtStar::searchTree(const Pose4& start, const Pose4& goal, std::uint64_t seed) const {
   // OMPL logs every solve at info level; keep warnings and errors only (process-wide, set once
   // so that concurrent solves do not race on it).
   static const bool quiet = (ompl::msg::setLogLevel(ompl::msg::LOG_WARN), true);

@@ -1,11 +1,11 @@
 #include "planner/topo_graph.h"
 
-#include "planner/check.h"
-
 #include <algorithm>
 #include <cmath>
 #include <queue>
 #include <stdexcept>
+
+#include "planner/check.h"
 
 namespace tgnav::planner {
 
@@ -87,7 +87,7 @@ void pruneSpurs(Mask& mask, double min_length_cells) {
             ++count;
             next = c;
           }
-          if (count == 0) break;                 // isolated segment: leave it
+          if (count == 0) break;  // isolated segment: leave it
           if (mask.neighbours(next.x(), next.y()) >= 3 || count > 1) {
             reached_junction = true;
             break;
@@ -241,8 +241,8 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
         }
         e.points_m.push_back(g.vertices[end_vertex].p_m);
         for (std::size_t i = 1; i < e.points_m.size(); ++i) e.length_m += (e.points_m[i] - e.points_m[i - 1]).norm();
-        e.min_clearance_m = std::min(min_clear, std::min(field.clearance(g.vertices[from].p_m),
-                                                         field.clearance(g.vertices[end_vertex].p_m)));
+        e.min_clearance_m = std::min(
+            min_clear, std::min(field.clearance(g.vertices[from].p_m), field.clearance(g.vertices[end_vertex].p_m)));
         g.edges.push_back(std::move(e));
         return;
       }

@@ -12,8 +12,8 @@
 namespace tgnav::planner {
 
 struct GvdConfig {
-  double robot_radius_m = 0.3;      // skeleton cells need at least this clearance
-  double min_spur_length_m = 0.5;   // dead-end branches shorter than this are dropped
+  double robot_radius_m = 0.3;     // skeleton cells need at least this clearance
+  double min_spur_length_m = 0.5;  // dead-end branches shorter than this are dropped
 
   void validate() const;
 };

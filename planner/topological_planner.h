@@ -27,6 +27,16 @@ struct TopoPlannerConfig {
   int max_expansions = 100000;    // cap on search effort (partial paths expanded)
   double max_length_ratio = 3.0;  // graph paths longer than this x the shortest are not searched
 
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("robot_radius_m", robot_radius_m);
+    a("max_classes", max_classes);
+    a("max_expansions", max_expansions);
+    a("max_length_ratio", max_length_ratio);
+    a("min_spur_length_m", min_spur_length_m);
+  }
+
   void validate() const;
 };
 

@@ -89,6 +89,34 @@ struct Reference {
   }
 };
 
+// Step 1 of the header, on the points' nominal times: the ramps, and the phases in real time.
+void allocateTime(const TrajectoryConfig& config, Reference* ref) {
+  // A B-spline pinned at rest with zero acceleration needs a few knot intervals to get going:
+  // a ramp shorter than that would only be caught up with by a speed bump.
+  const double knot_s = config.knot_spacing_m / config.nominal_speed_mps;
+  ref->ramp_s = std::max(config.nominal_speed_mps / config.nominal_accel_mps2, 3.0 * knot_s);
+  // Phases: runs of steps that move, and turns on the spot between them (the vehicle comes to rest
+  // for a turn, so the next run ramps up from rest again).
+  for (std::size_t k = 1; k < ref->p.size(); ++k) {
+    const bool travel = (ref->p[k] - ref->p[k - 1]).norm() >= 1e-6;
+    if (ref->phases.empty() || ref->phases.back().travel != travel) {
+      Reference::Phase ph;
+      ph.sigma0 = ph.sigma1 = ref->sigma[k - 1];
+      ph.travel = travel;
+      ref->phases.push_back(ph);
+    }
+    ref->phases.back().sigma1 = ref->sigma[k];
+  }
+  double t = 0.0;
+  for (Reference::Phase& ph : ref->phases) {
+    ph.t0 = t;
+    ph.duration = ph.travel ? ref->travelTime(ph.sigma1 - ph.sigma0) : ph.sigma1 - ph.sigma0;
+    t += ph.duration;
+  }
+  ref->duration_s = t;
+}
+
+// The path's points with unwrapped yaw (repeats dropped) and their nominal times, then timed.
 Reference makeReference(const TrajectoryRequest& request, const TrajectoryConfig& config) {
   Reference ref;
   auto add = [&](const Eigen::Vector3d& p, double yaw) {
@@ -109,29 +137,7 @@ Reference makeReference(const TrajectoryRequest& request, const TrajectoryConfig
   if (std::isfinite(request.start_yaw_rad)) add(request.path.front().p_WB, request.start_yaw_rad);
   for (const Pose4& pose : request.path) add(pose.p_WB, pose.yaw_rad);
   ref.p.back() = request.path.back().p_WB;  // exactly at the goal (a dropped repeat is < 1 um away)
-  // A B-spline pinned at rest with zero acceleration needs a few knot intervals to get going:
-  // a ramp shorter than that would only be caught up with by a speed bump.
-  const double knot_s = config.knot_spacing_m / config.nominal_speed_mps;
-  ref.ramp_s = std::max(config.nominal_speed_mps / config.nominal_accel_mps2, 3.0 * knot_s);
-  // Phases: runs of steps that move, and turns on the spot between them (the vehicle comes to rest
-  // for a turn, so the next run ramps up from rest again).
-  for (std::size_t k = 1; k < ref.p.size(); ++k) {
-    const bool travel = (ref.p[k] - ref.p[k - 1]).norm() >= 1e-6;
-    if (ref.phases.empty() || ref.phases.back().travel != travel) {
-      Reference::Phase ph;
-      ph.sigma0 = ph.sigma1 = ref.sigma[k - 1];
-      ph.travel = travel;
-      ref.phases.push_back(ph);
-    }
-    ref.phases.back().sigma1 = ref.sigma[k];
-  }
-  double t = 0.0;
-  for (Reference::Phase& ph : ref.phases) {
-    ph.t0 = t;
-    ph.duration = ph.travel ? ref.travelTime(ph.sigma1 - ph.sigma0) : ph.sigma1 - ph.sigma0;
-    t += ph.duration;
-  }
-  ref.duration_s = t;
+  allocateTime(config, &ref);
   return ref;
 }
 
@@ -446,6 +452,262 @@ void fillReport(const Measured& m, TrajectoryReport* report) {
   report->max_yaw_rate_rad_s = m.max_yaw_rate;
 }
 
+// ---------------------------------------------------------------------------------------------
+// The steps of generateTrajectory.
+
+void checkRequest(const TrajectoryRequest& request, const TrajectoryConfig& config) {
+  config.validate();
+  if (request.path.empty()) throw std::invalid_argument("path: empty (a trajectory needs at least the start)");
+  for (std::size_t i = 0; i < request.path.size(); ++i) {
+    const Pose4& p = request.path[i];
+    if (!p.p_WB.allFinite() || !std::isfinite(p.yaw_rad)) {
+      throw std::invalid_argument("path: point " + std::to_string(i) + " is not finite");
+    }
+  }
+}
+
+// The path's clearance, sampled every 1 cm along its segments, and where it is smallest.
+void pathClearance(const std::vector<Eigen::Vector3d>& path, const ClearanceField& field, double* clearance,
+                   Eigen::Vector3d* closest) {
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const Eigen::Vector3d a = path[k];
+    const Eigen::Vector3d b = k + 1 < path.size() ? path[k + 1] : a;
+    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.01)));
+    for (int i = 0; i < steps; ++i) {
+      const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(i) / steps);
+      const double d = field.clearance(p, nullptr);
+      if (d < *clearance) {
+        *clearance = d;
+        *closest = p;
+      }
+    }
+  }
+}
+
+// A request, and what generateTrajectory derives from it before optimising.
+struct Problem {
+  Problem(const TrajectoryRequest& request, const ClearanceField& field, const TrajectoryConfig& config);
+
+  const TrajectoryRequest& request;
+  const ClearanceField& field;
+  const TrajectoryConfig& config;
+  Reference ref;
+  // The path's own safety decides whether there is a fallback.
+  double path_clearance = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d path_closest;  // where the path is closest to an obstacle
+  bool path_safe = false;
+  ClearanceTarget target;
+  std::vector<double> signature;  // the path's winding angles (H-signature), given obstacle points
+};
+
+Problem::Problem(const TrajectoryRequest& request, const ClearanceField& field, const TrajectoryConfig& config)
+    : request(request), field(field), config(config), ref(makeReference(request, config)), path_closest(ref.p.front()) {
+  pathClearance(ref.p, field, &path_clearance, &path_closest);
+  path_safe = path_clearance >= config.robot_radius_m - 1e-3;
+  target.margin = config.margin_m();
+  target.start = ref.p.front();
+  target.goal = ref.p.back();
+  target.start_clearance = field.clearance(target.start, nullptr);
+  target.goal_clearance = field.clearance(target.goal, nullptr);
+  if (request.obstacle_points) {
+    std::vector<Eigen::Vector2d> xy;
+    for (const auto& p : ref.p) xy.push_back(p.head<2>());
+    signature = windingAngles(xy, *request.obstacle_points);
+  }
+}
+
+// The path itself flown point to point (StopAndGoTrajectory), measured into `report`.
+TrajectoryReport flyPath(const Problem& problem, TrajectoryStatus status, TrajectoryReport report) {
+  report.status = status;
+  report.trajectory = std::make_shared<StopAndGoTrajectory>(problem.ref, problem.config);
+  fillReport(measure(*report.trajectory, problem.field, problem.target), &report);
+  report.homology_checked = problem.request.obstacle_points != nullptr;
+  report.same_homology = true;  // the path itself
+  report.time_scale = 1.0;
+  return report;
+}
+
+// Step 4's fallback, with the reason: the path itself (safe where the path is), or kFailed where
+// the path itself comes closer than the robot radius.
+TrajectoryReport fallBack(const Problem& problem, TrajectoryReport report, const std::string& reason) {
+  report.reason = reason;
+  if (!problem.path_safe) {
+    std::ostringstream msg;
+    msg << reason << "; and the path itself comes within " << std::max(0.0, problem.path_clearance)
+        << " m of an obstacle at " << where(problem.path_closest) << " (robot radius " << problem.config.robot_radius_m
+        << " m)";
+    report.status = TrajectoryStatus::kFailed;
+    report.reason = msg.str();
+    report.trajectory.reset();
+    return report;
+  }
+  return flyPath(problem, TrajectoryStatus::kFallback, std::move(report));
+}
+
+// Knots on the reference's time line and the control points the fits start from.
+struct SplineStart {
+  int spans = 0;
+  double dt = 0.0;  // knot interval
+  Eigen::MatrixXd qp;
+  Eigen::MatrixXd qy;
+  std::vector<bool> fixed_p;  // control points the fits leave as they are
+  std::vector<bool> fixed_y;
+};
+
+// Fixes the position throughout every span that lies within a turn on the spot (smoothing would
+// otherwise let it creep while turning and back up before setting off, like any low-pass filter
+// rings).
+void holdStillWhileTurning(const Reference& ref, SplineStart* s) {
+  const int n = static_cast<int>(s->qp.rows());
+  for (const Reference::Phase& ph : ref.phases) {
+    if (ph.travel) continue;
+    Eigen::Vector3d spot;
+    double unused = 0.0;
+    ref.at(ph.sigma0, &spot, &unused);
+    const int first = static_cast<int>(std::ceil(ph.t0 / s->dt - 1e-9));
+    const int last = static_cast<int>(std::floor((ph.t0 + ph.duration) / s->dt + 1e-9)) - 1;  // spans inside
+    for (int j = first; j <= last; ++j) {
+      for (int k = j; k < j + 4 && k < n; ++k) {
+        s->fixed_p[static_cast<std::size_t>(k)] = true;
+        s->qp.row(k) = spot.transpose();
+      }
+    }
+  }
+}
+
+// Knots knot_spacing_m / v_nom apart (at least 6 spans) and the control points from the
+// reference; fixed: the ends (rest to rest) and the position while turning on the spot.
+SplineStart startSplines(const Reference& ref, const TrajectoryConfig& config) {
+  SplineStart s;
+  const double T0 = ref.duration_s;
+  s.spans = std::max(6, static_cast<int>(std::ceil(T0 / (config.knot_spacing_m / config.nominal_speed_mps))));
+  s.dt = T0 / s.spans;
+  const int n = s.spans + 3;
+  s.qp.resize(n, 3);
+  s.qy.resize(n, 1);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d p;
+    double psi = 0.0;
+    const double t = i <= 2 ? 0.0 : i >= s.spans ? T0 : (i - 1) * s.dt;
+    ref.at(ref.sigmaAt(t), &p, &psi);
+    s.qp.row(i) = p.transpose();
+    s.qy(i, 0) = psi;
+  }
+  s.fixed_p.assign(static_cast<std::size_t>(n), false);
+  s.fixed_y.assign(static_cast<std::size_t>(n), false);
+  for (int i : {0, 1, 2, n - 3, n - 2, n - 1})
+    s.fixed_p[static_cast<std::size_t>(i)] = s.fixed_y[static_cast<std::size_t>(i)] = true;
+  holdStillWhileTurning(ref, &s);
+  return s;
+}
+
+constexpr int kReferenceSamplesPerSpan = 2;
+
+// Reference samples for the closeness term, kReferenceSamplesPerSpan per span.
+void sampleReference(const Reference& ref, const SplineStart& s, std::vector<FitSample>* ref_p,
+                     std::vector<FitSample>* ref_y) {
+  for (int j = 0; j <= s.spans * kReferenceSamplesPerSpan; ++j) {
+    const double t = j * s.dt / kReferenceSamplesPerSpan;
+    Eigen::Vector3d p;
+    double psi = 0.0;
+    ref.at(ref.sigmaAt(t), &p, &psi);
+    ref_p->push_back({t, p});
+    ref_y->push_back({t, Eigen::VectorXd::Constant(1, psi)});
+  }
+}
+
+// A fit on the start's knots with the terms position and yaw share: closeness to the reference
+// (weight w_r of the header) and feasibility.
+SplineFit makeFit(const Eigen::MatrixXd& q, const std::vector<bool>& fixed, double dt, std::vector<FitSample> reference,
+                  const TrajectoryConfig& config) {
+  SplineFit fit(q, dt, fixed);
+  fit.reference = std::move(reference);
+  fit.ref_h = dt / kReferenceSamplesPerSpan;
+  fit.w_ref = std::pow(kTwoPi * config.nominal_speed_mps / config.smoothing_length_m, 6);
+  // Feasibility on the relative excess, scaled to the closeness term's m^2 by the knot spacing.
+  fit.w_feas = config.feasibility_weight * fit.w_ref * config.knot_spacing_m * config.knot_spacing_m;
+  return fit;
+}
+
+// Steps 2 and 3 of the header: position (with clearance) and yaw fitted on the same knots.
+// Closer than the robot radius: the clearance term stiffened (twice at most). The margin beyond
+// the radius stays a soft target (a passage narrower than twice the margin cannot have it).
+// `m` gets the result measured; `iterations` adds the L-BFGS iterations.
+std::shared_ptr<BSplineTrajectory> optimise(const Problem& problem, Measured* m, int* iterations) {
+  const TrajectoryConfig& config = problem.config;
+  const SplineStart s = startSplines(problem.ref, config);
+  std::vector<FitSample> ref_p;
+  std::vector<FitSample> ref_y;
+  sampleReference(problem.ref, s, &ref_p, &ref_y);
+
+  SplineFit pos = makeFit(s.qp, s.fixed_p, s.dt, std::move(ref_p), config);
+  pos.v_max = config.max_speed_mps;
+  pos.a_max = config.max_accel_mps2;
+  pos.field = &problem.field;
+  pos.target = problem.target;
+  pos.target_extra = kMarginBuffer_m;
+  pos.w_clear = config.clearance_weight * pos.w_ref;
+  *iterations += pos.optimise(config.max_iterations);
+
+  SplineFit yaw = makeFit(s.qy, s.fixed_y, s.dt, std::move(ref_y), config);
+  yaw.v_max = config.max_yaw_rate_rad_s;
+  *iterations += yaw.optimise(config.max_iterations);
+
+  auto spline = [&] {
+    return std::make_shared<BSplineTrajectory>(UniformBSpline(pos.controlPoints(), s.dt),
+                                               UniformBSpline(yaw.controlPoints(), s.dt));
+  };
+  std::shared_ptr<BSplineTrajectory> trajectory = spline();
+  *m = measure(*trajectory, problem.field, problem.target);
+  for (int round = 0; round < 2 && m->min_clearance < config.robot_radius_m; ++round) {
+    pos.w_clear *= 10.0;
+    *iterations += pos.optimise(config.max_iterations);
+    trajectory = spline();
+    *m = measure(*trajectory, problem.field, problem.target);
+  }
+  return trajectory;
+}
+
+// Step 4's checks of the shape, which re-timing cannot change: clearance >= robot radius and,
+// given obstacle points, the path's homology class. Returns why it failed (empty if it passed).
+std::string checkShape(const Problem& problem, const Trajectory& trajectory, const Measured& m,
+                       TrajectoryReport* report) {
+  if (m.min_clearance < problem.config.robot_radius_m) {
+    std::ostringstream msg;
+    msg << "optimised trajectory comes within " << std::max(0.0, m.min_clearance) << " m of an obstacle at "
+        << where(m.closest) << " (robot radius " << problem.config.robot_radius_m << " m)";
+    return msg.str();
+  }
+  if (problem.request.obstacle_points) {
+    report->homology_checked = true;
+    report->same_homology = TopologicalPlanner::sameClass(
+        windingAngles(planar(trajectory, problem.config.sample_rate_hz), *problem.request.obstacle_points),
+        problem.signature);
+    if (!report->same_homology) return "optimised trajectory left the path's homology class";
+  }
+  return "";
+}
+
+// Re-time until the limits hold: stretching the knot interval by s divides velocity by s,
+// acceleration by s^2, and leaves the shape alone.
+void retime(const Problem& problem, BSplineTrajectory* trajectory, Measured* m, int* retimes) {
+  const TrajectoryConfig& config = problem.config;
+  for (int round = 0; round < 4; ++round) {
+    const double scale =
+        std::max({1.0, m->max_speed / config.max_speed_mps, std::sqrt(m->max_accel / config.max_accel_mps2),
+                  m->max_yaw_rate / config.max_yaw_rate_rad_s});
+    if (scale <= 1.0) break;
+    ++*retimes;
+    trajectory->setKnotInterval(trajectory->position().knotInterval() * scale * 1.01);
+    *m = measure(*trajectory, problem.field, problem.target);
+  }
+}
+
+bool exceedsLimits(const Measured& m, const TrajectoryConfig& config) {
+  return m.max_speed > config.max_speed_mps || m.max_accel > config.max_accel_mps2 ||
+         m.max_yaw_rate > config.max_yaw_rate_rad_s;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -550,191 +812,22 @@ std::vector<TrajectorySample> sampleTrajectory(const Trajectory& trajectory, dou
 
 TrajectoryReport generateTrajectory(const TrajectoryRequest& request, const ClearanceField& field,
                                     const TrajectoryConfig& config) {
-  config.validate();
-  if (request.path.empty()) throw std::invalid_argument("path: empty (a trajectory needs at least the start)");
-  for (std::size_t i = 0; i < request.path.size(); ++i) {
-    const Pose4& p = request.path[i];
-    if (!p.p_WB.allFinite() || !std::isfinite(p.yaw_rad)) {
-      throw std::invalid_argument("path: point " + std::to_string(i) + " is not finite");
-    }
-  }
-  const Reference ref = makeReference(request, config);
+  checkRequest(request, config);
+  const Problem problem(request, field, config);
   TrajectoryReport report;
+  if (problem.ref.p.size() == 1) return flyPath(problem, TrajectoryStatus::kOptimised, report);  // nothing to do: stay
 
-  // The path's own safety decides whether there is a fallback.
-  double path_clearance = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d path_closest = ref.p.front();
-  for (std::size_t k = 0; k < ref.p.size(); ++k) {
-    const Eigen::Vector3d a = ref.p[k];
-    const Eigen::Vector3d b = k + 1 < ref.p.size() ? ref.p[k + 1] : a;
-    const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.01)));
-    for (int i = 0; i < steps; ++i) {
-      const Eigen::Vector3d p = a + (b - a) * (static_cast<double>(i) / steps);
-      const double d = field.clearance(p, nullptr);
-      if (d < path_clearance) {
-        path_clearance = d;
-        path_closest = p;
-      }
-    }
-  }
-  const bool path_safe = path_clearance >= config.robot_radius_m - 1e-3;
-  ClearanceTarget target;
-  target.margin = config.margin_m();
-  target.start = ref.p.front();
-  target.goal = ref.p.back();
-  target.start_clearance = field.clearance(target.start, nullptr);
-  target.goal_clearance = field.clearance(target.goal, nullptr);
-  std::vector<double> signature;
-  if (request.obstacle_points) {
-    std::vector<Eigen::Vector2d> xy;
-    for (const auto& p : ref.p) xy.push_back(p.head<2>());
-    signature = windingAngles(xy, *request.obstacle_points);
-  }
-
-  auto fallback = [&](const std::string& reason) {
-    report.reason = reason;
-    if (!path_safe) {
-      std::ostringstream msg;
-      msg << reason << "; and the path itself comes within " << std::max(0.0, path_clearance) << " m of an obstacle at "
-          << where(path_closest) << " (robot radius " << config.robot_radius_m << " m)";
-      report.status = TrajectoryStatus::kFailed;
-      report.reason = msg.str();
-      report.trajectory.reset();
-      return report;
-    }
-    report.status = TrajectoryStatus::kFallback;
-    report.trajectory = std::make_shared<StopAndGoTrajectory>(ref, config);
-    fillReport(measure(*report.trajectory, field, target), &report);
-    report.homology_checked = request.obstacle_points != nullptr;
-    report.same_homology = true;  // the path itself
-    report.time_scale = 1.0;
-    return report;
-  };
-
-  if (ref.p.size() == 1) {  // nothing to do: stay
-    report.status = TrajectoryStatus::kOptimised;
-    report.trajectory = std::make_shared<StopAndGoTrajectory>(ref, config);
-    fillReport(measure(*report.trajectory, field, target), &report);
-    report.homology_checked = request.obstacle_points != nullptr;
-    report.same_homology = true;
-    return report;
-  }
-
-  // Knots and initial control points from the reference.
-  const double T0 = ref.duration_s;
-  const int spans = std::max(6, static_cast<int>(std::ceil(T0 / (config.knot_spacing_m / config.nominal_speed_mps))));
-  const double dt = T0 / spans;
-  const int n = spans + 3;
-  Eigen::MatrixXd qp(n, 3);
-  Eigen::MatrixXd qy(n, 1);
-  for (int i = 0; i < n; ++i) {
-    Eigen::Vector3d p;
-    double psi = 0.0;
-    const double t = i <= 2 ? 0.0 : i >= spans ? T0 : (i - 1) * dt;
-    ref.at(ref.sigmaAt(t), &p, &psi);
-    qp.row(i) = p.transpose();
-    qy(i, 0) = psi;
-  }
-  // Fixed: the ends (rest to rest), and the position throughout every span that lies within a
-  // turn on the spot (smoothing would otherwise let it creep while turning and back up before
-  // setting off, like any low-pass filter rings).
-  std::vector<bool> fixed_p(static_cast<std::size_t>(n), false);
-  std::vector<bool> fixed_y(static_cast<std::size_t>(n), false);
-  for (int i : {0, 1, 2, n - 3, n - 2, n - 1})
-    fixed_p[static_cast<std::size_t>(i)] = fixed_y[static_cast<std::size_t>(i)] = true;
-  for (const Reference::Phase& ph : ref.phases) {
-    if (ph.travel) continue;
-    Eigen::Vector3d spot;
-    double unused = 0.0;
-    ref.at(ph.sigma0, &spot, &unused);
-    const int first = static_cast<int>(std::ceil(ph.t0 / dt - 1e-9));
-    const int last = static_cast<int>(std::floor((ph.t0 + ph.duration) / dt + 1e-9)) - 1;  // spans inside
-    for (int j = first; j <= last; ++j) {
-      for (int k = j; k < j + 4 && k < n; ++k) {
-        fixed_p[static_cast<std::size_t>(k)] = true;
-        qp.row(k) = spot.transpose();
-      }
-    }
-  }
-  // Reference samples, two per span.
-  const int per_span = 2;
-  std::vector<FitSample> ref_p;
-  std::vector<FitSample> ref_y;
-  for (int j = 0; j <= spans * per_span; ++j) {
-    const double t = j * dt / per_span;
-    Eigen::Vector3d p;
-    double psi = 0.0;
-    ref.at(ref.sigmaAt(t), &p, &psi);
-    ref_p.push_back({t, p});
-    ref_y.push_back({t, Eigen::VectorXd::Constant(1, psi)});
-  }
-  const double w_ref = std::pow(kTwoPi * config.nominal_speed_mps / config.smoothing_length_m, 6);
-
-  SplineFit pos(qp, dt, fixed_p);
-  pos.reference = ref_p;
-  pos.ref_h = dt / per_span;
-  pos.w_ref = w_ref;
-  pos.v_max = config.max_speed_mps;
-  pos.a_max = config.max_accel_mps2;
-  // Feasibility on the relative excess, scaled to the closeness term's m^2 by the knot spacing.
-  const double w_feas = config.feasibility_weight * w_ref * config.knot_spacing_m * config.knot_spacing_m;
-  pos.w_feas = w_feas;
-  pos.field = &field;
-  pos.target = target;
-  pos.target_extra = kMarginBuffer_m;
-  pos.w_clear = config.clearance_weight * w_ref;
-  report.iterations += pos.optimise(config.max_iterations);
-
-  SplineFit yaw(qy, dt, fixed_y);
-  yaw.reference = ref_y;
-  yaw.ref_h = dt / per_span;
-  yaw.w_ref = w_ref;
-  yaw.v_max = config.max_yaw_rate_rad_s;
-  yaw.w_feas = w_feas;
-  report.iterations += yaw.optimise(config.max_iterations);
-
-  // Closer than the robot radius: stiffen the clearance term (twice at most). The margin beyond
-  // the radius stays a soft target (a passage narrower than twice the margin cannot have it).
-  auto trajectory = std::make_shared<BSplineTrajectory>(UniformBSpline(pos.controlPoints(), dt),
-                                                        UniformBSpline(yaw.controlPoints(), dt));
-  Measured m = measure(*trajectory, field, target);
-  for (int round = 0; round < 2 && m.min_clearance < config.robot_radius_m; ++round) {
-    pos.w_clear *= 10.0;
-    report.iterations += pos.optimise(config.max_iterations);
-    trajectory = std::make_shared<BSplineTrajectory>(UniformBSpline(pos.controlPoints(), dt),
-                                                     UniformBSpline(yaw.controlPoints(), dt));
-    m = measure(*trajectory, field, target);
-  }
-  if (m.min_clearance < config.robot_radius_m) {
-    std::ostringstream msg;
-    msg << "optimised trajectory comes within " << std::max(0.0, m.min_clearance) << " m of an obstacle at "
-        << where(m.closest) << " (robot radius " << config.robot_radius_m << " m)";
-    return fallback(msg.str());
-  }
-  if (request.obstacle_points) {
-    report.homology_checked = true;
-    report.same_homology = TopologicalPlanner::sameClass(
-        windingAngles(planar(*trajectory, config.sample_rate_hz), *request.obstacle_points), signature);
-    if (!report.same_homology) return fallback("optimised trajectory left the path's homology class");
-  }
-  // Re-time until the limits hold: stretching the knot interval by s divides velocity by s,
-  // acceleration by s^2, and leaves the shape alone.
-  for (int round = 0; round < 4; ++round) {
-    const double scale =
-        std::max({1.0, m.max_speed / config.max_speed_mps, std::sqrt(m.max_accel / config.max_accel_mps2),
-                  m.max_yaw_rate / config.max_yaw_rate_rad_s});
-    if (scale <= 1.0) break;
-    ++report.retimes;
-    trajectory->setKnotInterval(trajectory->position().knotInterval() * scale * 1.01);
-    m = measure(*trajectory, field, target);
-  }
-  if (m.max_speed > config.max_speed_mps || m.max_accel > config.max_accel_mps2 ||
-      m.max_yaw_rate > config.max_yaw_rate_rad_s) {
-    return fallback("re-timing did not bring speed, acceleration and yaw rate within limits");
+  Measured m;
+  const std::shared_ptr<BSplineTrajectory> trajectory = optimise(problem, &m, &report.iterations);
+  const std::string failure = checkShape(problem, *trajectory, m, &report);
+  if (!failure.empty()) return fallBack(problem, report, failure);
+  retime(problem, trajectory.get(), &m, &report.retimes);
+  if (exceedsLimits(m, config)) {
+    return fallBack(problem, report, "re-timing did not bring speed, acceleration and yaw rate within limits");
   }
   report.status = TrajectoryStatus::kOptimised;
   report.trajectory = trajectory;
-  report.time_scale = trajectory->duration() / T0;
+  report.time_scale = trajectory->duration() / problem.ref.duration_s;
   fillReport(m, &report);
   return report;
 }

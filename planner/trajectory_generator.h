@@ -86,6 +86,25 @@ struct TrajectoryConfig {
   int max_iterations = 300;           // L-BFGS iterations per optimisation
   double sample_rate_hz = 100.0;      // setpoints written out (the position controller's rate)
 
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("nominal_speed_mps", nominal_speed_mps);
+    a("nominal_accel_mps2", nominal_accel_mps2);
+    a("nominal_yaw_rate_rad_s", nominal_yaw_rate_rad_s);
+    a("max_speed_mps", max_speed_mps);
+    a("max_accel_mps2", max_accel_mps2);
+    a("max_yaw_rate_rad_s", max_yaw_rate_rad_s);
+    a("robot_radius_m", robot_radius_m);
+    a("safety_margin_m", safety_margin_m);
+    a("knot_spacing_m", knot_spacing_m);
+    a("smoothing_length_m", smoothing_length_m);
+    a("clearance_weight", clearance_weight);
+    a("feasibility_weight", feasibility_weight);
+    a("max_iterations", max_iterations);
+    a("sample_rate_hz", sample_rate_hz);
+  }
+
   double margin_m() const { return robot_radius_m + safety_margin_m; }
   void validate() const;  // std::invalid_argument naming the field and value
 };

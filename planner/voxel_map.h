@@ -20,10 +20,10 @@ enum class VoxelState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
 
 // Landmarks that share a surface voxel: visibility is decided once per voxel.
 struct LandmarkVoxel {
-  int index = 0;                // flat voxel index in the VoxelMap
-  Eigen::Vector3d centre_W;     // voxel centre
-  Eigen::Vector3d mean_W;       // mean position of its landmarks
-  std::vector<int> ids;         // landmark ids, ascending
+  int index = 0;             // flat voxel index in the VoxelMap
+  Eigen::Vector3d centre_W;  // voxel centre
+  Eigen::Vector3d mean_W;    // mean position of its landmarks
+  std::vector<int> ids;      // landmark ids, ascending
 };
 
 class VoxelMap {
@@ -68,9 +68,7 @@ class VoxelMap {
  private:
   int flat(int x, int y, int z) const { return (z * size_.y() + y) * size_.x() + x; }
   Eigen::Vector3i cellOf(const Eigen::Vector3d& p_W) const;
-  bool inside(const Eigen::Vector3i& c) const {
-    return (c.array() >= 0).all() && (c.array() < size_.array()).all();
-  }
+  bool inside(const Eigen::Vector3i& c) const { return (c.array() >= 0).all() && (c.array() < size_.array()).all(); }
   Eigen::Vector3d centreOf(int index) const;
   double centreDistance(const Eigen::Vector3i& c) const;
   void computeDistanceField();
@@ -88,8 +86,8 @@ class VoxelMap {
   std::size_t padded(const Eigen::Vector3i& c) const {
     return (static_cast<std::size_t>(c.z() - edt_z0_ + 1) * (size_.y() + 2) + c.y() + 1) * (size_.x() + 2) + c.x() + 1;
   }
-  std::vector<float> dist2_;   // squared distance in voxels from each centre to the nearest obstacle centre
-  std::vector<int> site_;      // that obstacle voxel (padded flat index; -1: none within the band)
+  std::vector<float> dist2_;  // squared distance in voxels from each centre to the nearest obstacle centre
+  std::vector<int> site_;     // that obstacle voxel (padded flat index; -1: none within the band)
   std::vector<LandmarkVoxel> landmark_voxels_;
   std::vector<int> landmark_slot_;
 };

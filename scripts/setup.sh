@@ -15,7 +15,8 @@ packages=(
   libopencv-contrib-dev               # cv::rgbd::RgbdOdometry, the peer in the VO benchmark
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL's CMake links these
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-matplotlib                  # tgnav report's figures, bench plots
+  python3-matplotlib                  # every figure (scripts/tgnav_plots.py)
+  clang-format-14                     # the style check (scripts/check_format.sh, CTest format.check)
   slurmctld slurmd slurm-client munge # the Slurm sweep backend's test (a private single-node cluster)
 )
 

@@ -16,6 +16,18 @@ struct FeatureConfig {
   int pyramid_levels = 8;
   int edge_threshold_px = 19;
 
+  // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("max_features", max_features);
+    a("grid_cols", grid_cols);
+    a("grid_rows", grid_rows);
+    a("fast_threshold", fast_threshold);
+    a("scale_factor", scale_factor);
+    a("pyramid_levels", pyramid_levels);
+    a("edge_threshold_px", edge_threshold_px);
+  }
+
   // Throws std::invalid_argument naming the field and value.
   void validate() const;
 };

@@ -66,6 +66,10 @@ int hamming(const std::array<std::uint64_t, 4>& a, const std::array<std::uint64_
          __builtin_popcountll(a[3] ^ b[3]);
 }
 
+cv::Matx33d cameraMatrix(const CameraIntrinsics& c) {
+  return cv::Matx33d(c.fx, 0.0, c.cx, 0.0, c.fy, c.cy, 0.0, 0.0, 1.0);
+}
+
 cv::Mat toGray(const cv::Mat& image) {
   if (image.type() == CV_8UC1) return image;
   cv::Mat gray;
@@ -112,6 +116,11 @@ const char* toString(TrackingStatus status) {
   return "?";
 }
 
+TrackingStatus decideStatus(int inliers, const OdometryConfig& config) {
+  if (inliers < config.min_inliers) return TrackingStatus::kLost;
+  return inliers < config.weak_inliers ? TrackingStatus::kWeak : TrackingStatus::kOk;
+}
+
 RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig& config, const Eigen::Isometry3d& X_WC0)
     : camera_(camera),
       config_(config),
@@ -127,7 +136,77 @@ RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig&
   require(std::isfinite(camera.cx) && std::isfinite(camera.cy), "camera.cx", camera.cx, "must be finite");
 }
 
+// A frame's features and their 3D points in the camera frame.
+struct RgbdOdometry::Frame {
+  Features features;
+  std::vector<Eigen::Vector3d> p_C;  // per keypoint, where valid
+  std::vector<bool> valid;           // depth in range and not on a discontinuity
+  int with_depth = 0;                // valid ones
+};
+
+// The local map's landmarks matched to a frame's keypoints, and the 2D-3D correspondences.
+struct RgbdOdometry::LocalMapMatches {
+  std::vector<int> landmark_of;     // keypoint -> landmark (-1: none)
+  std::vector<bool> expected;       // landmark -> projects into the image from the prediction
+  std::vector<cv::Point3d> object;  // landmark positions, in keypoint order
+  std::vector<cv::Point2d> pixels;  // their keypoints' pixels
+  std::vector<int> keypoint;        // correspondence -> keypoint
+};
+
+struct RgbdOdometry::PoseEstimate {
+  bool ransac_ok = false;  // PnP RANSAC found a pose with at least min_inliers inliers
+  int ransac_inliers = 0;
+  int inliers = -1;  // of the refined pose among all correspondences (-1: non-finite pose)
+  Eigen::Isometry3d X_CW = Eigen::Isometry3d::Identity();
+  std::vector<bool> is_inlier;  // per correspondence
+};
+
 FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat& depth_m) {
+  checkFrame(t_s, image, depth_m);
+  last_t_ = t_s;
+  ++frame_;
+
+  FrameResult result;
+  result.t_s = t_s;
+  result.X_WC = X_WC_;
+  if (failed_ && !config_.reinitialise_after_lost) {
+    std::ostringstream msg;
+    msg << "lost at t = " << failed_at_ << " s (no re-initialisation)";
+    result.reason = msg.str();
+    return record(result);
+  }
+  const Frame frame = prepareFrame(image, depth_m);
+  result.features = static_cast<int>(frame.features.keypoints.size());
+  result.with_depth = frame.with_depth;
+  if (!initialised_) return record(initialise(result, frame));
+
+  const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
+  const LocalMapMatches matches = matchLocalMap(frame, X_CW_pred);
+  result.matches = static_cast<int>(matches.object.size());
+  if (result.matches < config_.min_inliers) {
+    return lose(result, std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
+  }
+  const PoseEstimate pose = estimatePose(matches, X_CW_pred);
+  if (!pose.ransac_ok) {
+    result.inliers = pose.ransac_inliers;
+    return lose(result, std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
+  }
+  if (pose.inliers < 0) return lose(result, "PnP gave a non-finite pose");
+  result.inliers = pose.inliers;
+  result.status = decideStatus(pose.inliers, config_);
+  if (result.status == TrackingStatus::kLost) {
+    return lose(result, std::to_string(pose.inliers) + " inliers < " + std::to_string(config_.min_inliers));
+  }
+
+  const Eigen::Isometry3d X_WC = pose.X_CW.inverse();
+  velocity_ = X_WC_.inverse() * X_WC;
+  X_WC_ = X_WC;
+  result.X_WC = X_WC;
+  result.keyframe = updateLocalMap(frame, matches, pose);
+  return record(result);
+}
+
+void RgbdOdometry::checkFrame(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const {
   if (!std::isfinite(t_s) || t_s <= last_t_) {
     std::ostringstream msg;
     msg << "frame time " << t_s << " s does not come after the previous frame's (" << last_t_ << " s)";
@@ -142,74 +221,89 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     throw std::invalid_argument("depth: expected CV_32FC1 metres of " + std::to_string(camera_.width_px) + "x" +
                                 std::to_string(camera_.height_px));
   }
-  last_t_ = t_s;
-  ++frame_;
+}
 
-  FrameResult result;
-  result.t_s = t_s;
-  result.X_WC = X_WC_;
-  if (failed_ && !config_.reinitialise_after_lost) {
-    std::ostringstream msg;
-    msg << "lost at t = " << failed_at_ << " s (no re-initialisation)";
-    result.reason = msg.str();
-    history_.push_back(result);
-    return result;
+RgbdOdometry::Frame RgbdOdometry::prepareFrame(const cv::Mat& image, const cv::Mat& depth_m) const {
+  Frame frame;
+  frame.features = detector_.detect(toGray(image));
+  const std::size_t n = frame.features.keypoints.size();
+  frame.p_C.resize(n);
+  frame.valid.assign(n, false);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!backProject(frame.features.keypoints[i], depth_m, &frame.p_C[i])) continue;
+    frame.valid[i] = true;
+    ++frame.with_depth;
   }
+  return frame;
+}
 
-  // Features and their 3D points in the camera frame.
-  const Features f = detector_.detect(toGray(image));
-  result.features = static_cast<int>(f.keypoints.size());
-  std::vector<Eigen::Vector3d> p_C(f.keypoints.size());
-  std::vector<bool> valid(f.keypoints.size(), false);
-  for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
-    const int u = static_cast<int>(std::lround(f.keypoints[i].pt.x));
-    const int v = static_cast<int>(std::lround(f.keypoints[i].pt.y));
-    if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) continue;
-    const float z = depth_m.at<float>(v, u);
-    if (!std::isfinite(z) || z < config_.min_depth_m || z > config_.max_depth_m) continue;
-    // Depth discontinuity: a keypoint on an object's silhouette has no reliable depth.
-    float lo = z, hi = z;
-    bool holes = false;
-    for (int dv = -1; dv <= 1; ++dv) {
-      for (int du = -1; du <= 1; ++du) {
-        const float d = depth_m.at<float>(v + dv, u + du);
-        if (!std::isfinite(d) || d <= 0.0f) holes = true;
-        lo = std::min(lo, d);
-        hi = std::max(hi, d);
-      }
+// The keypoint's 3D point in the camera frame, if its depth is in range and reliable.
+bool RgbdOdometry::backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const {
+  const int u = static_cast<int>(std::lround(keypoint.pt.x));
+  const int v = static_cast<int>(std::lround(keypoint.pt.y));
+  if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) return false;
+  const float z = depth_m.at<float>(v, u);
+  if (!std::isfinite(z) || z < config_.min_depth_m || z > config_.max_depth_m) return false;
+  // Depth discontinuity: a keypoint on an object's silhouette has no reliable depth.
+  float lo = z, hi = z;
+  bool holes = false;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const float d = depth_m.at<float>(v + dv, u + du);
+      if (!std::isfinite(d) || d <= 0.0f) holes = true;
+      lo = std::min(lo, d);
+      hi = std::max(hi, d);
     }
-    if (holes || hi - lo > config_.depth_edge_m * z) continue;
-    const double x = (f.keypoints[i].pt.x - camera_.cx) * z / camera_.fx;
-    const double y = (f.keypoints[i].pt.y - camera_.cy) * z / camera_.fy;
-    p_C[i] = Eigen::Vector3d(x, y, z);
-    valid[i] = true;
-    ++result.with_depth;
   }
+  if (holes || hi - lo > config_.depth_edge_m * z) return false;
+  const double x = (keypoint.pt.x - camera_.cx) * z / camera_.fx;
+  const double y = (keypoint.pt.y - camera_.cy) * z / camera_.fy;
+  *p_C = Eigen::Vector3d(x, y, z);
+  return true;
+}
 
-  if (!initialised_) {
-    result = initialise(result, f, p_C, valid);
-    history_.push_back(result);
+FrameResult RgbdOdometry::initialise(FrameResult result, const Frame& frame) {
+  if (result.with_depth < config_.init_min_features) {
+    result.status = TrackingStatus::kLost;
+    result.reason = std::to_string(result.with_depth) + " features with depth < " +
+                    std::to_string(config_.init_min_features) + " to initialise";
+    markFailed(result.t_s);
     return result;
   }
+  initialised_ = true;
+  result.reinitialised = !history_.empty();
+  X_WC_ = X_WC0_;
+  velocity_.setIdentity();
+  landmarks_.clear();
+  keyframes_.clear();
+  addKeyframe(X_WC_, frame, std::vector<int>(frame.features.keypoints.size(), -1), 0);
+  result.X_WC = X_WC_;
+  result.status = TrackingStatus::kOk;
+  result.inliers = result.with_depth;
+  result.keyframe = true;
+  return result;
+}
 
-  // Match the local map's landmarks to this frame's keypoints around their predicted pixels.
-  const Eigen::Isometry3d X_WC_pred = X_WC_ * velocity_;
-  const Eigen::Isometry3d X_CW_pred = X_WC_pred.inverse();
+// Matches the local map's landmarks to the frame's keypoints around their predicted pixels.
+RgbdOdometry::LocalMapMatches RgbdOdometry::matchLocalMap(const Frame& frame,
+                                                          const Eigen::Isometry3d& X_CW_pred) const {
+  const Features& f = frame.features;
   const double radius = config_.search_radius_px;
   const KeypointGrid grid(f.keypoints, camera_.width_px, camera_.height_px, radius);
   std::vector<std::array<std::uint64_t, 4>> bits(f.keypoints.size());
   for (std::size_t i = 0; i < bits.size(); ++i) bits[i] = descriptorBits(f.descriptors, static_cast<int>(i));
   const double r2 = radius * radius;
-  std::vector<int> best_landmark(f.keypoints.size(), -1);  // keypoint -> landmark
+  LocalMapMatches m;
+  m.landmark_of.assign(f.keypoints.size(), -1);
   std::vector<int> best_distance(f.keypoints.size(), std::numeric_limits<int>::max());
-  std::vector<bool> expected(landmarks_.size(), false);
+  m.expected.assign(landmarks_.size(), false);
   for (std::size_t l = 0; l < landmarks_.size(); ++l) {
     const Eigen::Vector3d q = X_CW_pred * landmarks_[l].p_W;
     if (q.z() < config_.min_depth_m) continue;
     const double u = camera_.fx * q.x() / q.z() + camera_.cx;
     const double v = camera_.fy * q.y() / q.z() + camera_.cy;
     if (u < 0.0 || v < 0.0 || u > camera_.width_px - 1 || v > camera_.height_px - 1) continue;
-    expected[l] = true;
+    m.expected[l] = true;
     int best = std::numeric_limits<int>::max(), second = std::numeric_limits<int>::max(), best_i = -1;
     grid.forEachNear(u, v, [&](int i) {
       const double du = f.keypoints[static_cast<std::size_t>(i)].pt.x - u;
@@ -229,45 +323,23 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     const std::size_t k = static_cast<std::size_t>(best_i);
     if (best < best_distance[k]) {  // one landmark per keypoint: the closest in descriptor space
       best_distance[k] = best;
-      best_landmark[k] = static_cast<int>(l);
+      m.landmark_of[k] = static_cast<int>(l);
     }
   }
-  std::vector<cv::Point3d> object;
-  std::vector<cv::Point2d> pixels;
-  std::vector<int> match_keypoint;
   for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
-    if (best_landmark[i] < 0) continue;
-    const Eigen::Vector3d& p = landmarks_[static_cast<std::size_t>(best_landmark[i])].p_W;
-    object.emplace_back(p.x(), p.y(), p.z());
-    pixels.emplace_back(f.keypoints[i].pt.x, f.keypoints[i].pt.y);
-    match_keypoint.push_back(static_cast<int>(i));
+    if (m.landmark_of[i] < 0) continue;
+    const Eigen::Vector3d& p = landmarks_[static_cast<std::size_t>(m.landmark_of[i])].p_W;
+    m.object.emplace_back(p.x(), p.y(), p.z());
+    m.pixels.emplace_back(f.keypoints[i].pt.x, f.keypoints[i].pt.y);
+    m.keypoint.push_back(static_cast<int>(i));
   }
-  result.matches = static_cast<int>(object.size());
+  return m;
+}
 
-  auto lose = [&](const std::string& why) {
-    result.status = TrackingStatus::kLost;
-    result.reason = why;
-    result.X_WC = X_WC_;
-    if (!failed_) {
-      failed_ = true;
-      failed_at_ = t_s;
-    }
-    if (config_.reinitialise_after_lost) {
-      initialised_ = false;
-      X_WC0_ = X_WC_;  // carry on from the last good pose
-      landmarks_.clear();
-      keyframes_.clear();
-      velocity_.setIdentity();
-    }
-    history_.push_back(result);
-    return result;
-  };
-  if (result.matches < config_.min_inliers) {
-    return lose(std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
-  }
-
-  // Pose: PnP RANSAC from the prediction, Levenberg-Marquardt on the inliers, inliers again.
-  const cv::Matx33d K(camera_.fx, 0.0, camera_.cx, 0.0, camera_.fy, camera_.cy, 0.0, 0.0, 1.0);
+// Pose: PnP RANSAC from the prediction, Levenberg-Marquardt on the inliers, inliers again.
+RgbdOdometry::PoseEstimate RgbdOdometry::estimatePose(const LocalMapMatches& matches,
+                                                      const Eigen::Isometry3d& X_CW_pred) const {
+  const cv::Matx33d K = cameraMatrix(camera_);
   cv::Mat r_pred, t_pred;
   {
     cv::Mat R;
@@ -278,82 +350,78 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
   cv::Mat rvec = r_pred.clone();
   cv::Mat tvec = t_pred.clone();
   std::vector<int> inliers;
-  const bool ok = cv::solvePnPRansac(object, pixels, K, cv::noArray(), rvec, tvec, true, config_.ransac_iterations,
-                                     static_cast<float>(config_.ransac_reprojection_px), config_.ransac_confidence,
-                                     inliers, cv::SOLVEPNP_EPNP);
-  if (!ok || static_cast<int>(inliers.size()) < config_.min_inliers) {
-    result.inliers = static_cast<int>(inliers.size());
-    return lose(std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
-  }
+  PoseEstimate pose;
+  const bool ok = cv::solvePnPRansac(matches.object, matches.pixels, K, cv::noArray(), rvec, tvec, true,
+                                     config_.ransac_iterations, static_cast<float>(config_.ransac_reprojection_px),
+                                     config_.ransac_confidence, inliers, cv::SOLVEPNP_EPNP);
+  pose.ransac_inliers = static_cast<int>(inliers.size());
+  pose.ransac_ok = ok && pose.ransac_inliers >= config_.min_inliers;
+  if (!pose.ransac_ok) return pose;
   std::vector<cv::Point3d> obj_in;
   std::vector<cv::Point2d> pix_in;
   for (int i : inliers) {
-    obj_in.push_back(object[static_cast<std::size_t>(i)]);
-    pix_in.push_back(pixels[static_cast<std::size_t>(i)]);
+    obj_in.push_back(matches.object[static_cast<std::size_t>(i)]);
+    pix_in.push_back(matches.pixels[static_cast<std::size_t>(i)]);
   }
   // Levenberg-Marquardt on RANSAC's inliers from two starts: RANSAC's pose, which EPnP on a
   // near-planar set (a wall filling the view) can get badly wrong, and the motion-model
   // prediction. The start whose refined pose has more inliers among all matches wins.
+  pose.inliers = refinePose(matches, obj_in, pix_in, rvec, tvec, &pose.X_CW, &pose.is_inlier);
+  Eigen::Isometry3d X_CW_alt;
+  std::vector<bool> alt_inlier;
+  const int n_alt = refinePose(matches, obj_in, pix_in, r_pred, t_pred, &X_CW_alt, &alt_inlier);
+  if (n_alt > pose.inliers) {
+    pose.inliers = n_alt;
+    pose.X_CW = X_CW_alt;
+    pose.is_inlier = std::move(alt_inlier);
+  }
+  return pose;
+}
+
+// Levenberg-Marquardt from (rvec, tvec) on RANSAC's inliers; returns the refined pose's inliers
+// among all matches (reprojection within ransac_reprojection_px), -1 if the pose is not finite.
+int RgbdOdometry::refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
+                             const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec,
+                             Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) const {
+  const cv::Matx33d K = cameraMatrix(camera_);
+  cv::solvePnPRefineLM(object_in, pixels_in, K, cv::noArray(), rvec, tvec);
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  Eigen::Matrix3d R_CW;
+  Eigen::Vector3d t_CW;
+  cv::cv2eigen(R, R_CW);
+  cv::cv2eigen(tvec, t_CW);
+  X_CW->setIdentity();
+  X_CW->linear() = R_CW;
+  X_CW->translation() = t_CW;
+  is_inlier->assign(matches.object.size(), false);
+  if (!X_CW->matrix().allFinite()) return -1;
   const double thr2 = config_.ransac_reprojection_px * config_.ransac_reprojection_px;
-  auto refine = [&](cv::Mat r, cv::Mat t, Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) {
-    cv::solvePnPRefineLM(obj_in, pix_in, K, cv::noArray(), r, t);
-    cv::Mat R;
-    cv::Rodrigues(r, R);
-    Eigen::Matrix3d R_CW;
-    Eigen::Vector3d t_CW;
-    cv::cv2eigen(R, R_CW);
-    cv::cv2eigen(t, t_CW);
-    X_CW->setIdentity();
-    X_CW->linear() = R_CW;
-    X_CW->translation() = t_CW;
-    is_inlier->assign(object.size(), false);
-    if (!X_CW->matrix().allFinite()) return -1;
-    int n = 0;
-    for (std::size_t m = 0; m < object.size(); ++m) {
-      const Eigen::Vector3d q = *X_CW * Eigen::Vector3d(object[m].x, object[m].y, object[m].z);
-      if (q.z() <= 0.0) continue;
-      const double du = camera_.fx * q.x() / q.z() + camera_.cx - pixels[m].x;
-      const double dv = camera_.fy * q.y() / q.z() + camera_.cy - pixels[m].y;
-      if (du * du + dv * dv <= thr2) {
-        (*is_inlier)[m] = true;
-        ++n;
-      }
-    }
-    return n;
-  };
-  Eigen::Isometry3d X_CW;
-  std::vector<bool> is_inlier;
-  int n_in = refine(rvec, tvec, &X_CW, &is_inlier);
-  {
-    Eigen::Isometry3d X_CW_alt;
-    std::vector<bool> alt_inlier;
-    const int n_alt = refine(r_pred, t_pred, &X_CW_alt, &alt_inlier);
-    if (n_alt > n_in) {
-      n_in = n_alt;
-      X_CW = X_CW_alt;
-      is_inlier = std::move(alt_inlier);
+  int n = 0;
+  for (std::size_t m = 0; m < matches.object.size(); ++m) {
+    const cv::Point3d& o = matches.object[m];
+    const Eigen::Vector3d q = *X_CW * Eigen::Vector3d(o.x, o.y, o.z);
+    if (q.z() <= 0.0) continue;
+    const double du = camera_.fx * q.x() / q.z() + camera_.cx - matches.pixels[m].x;
+    const double dv = camera_.fy * q.y() / q.z() + camera_.cy - matches.pixels[m].y;
+    if (du * du + dv * dv <= thr2) {
+      (*is_inlier)[m] = true;
+      ++n;
     }
   }
-  if (n_in < 0) return lose("PnP gave a non-finite pose");
+  return n;
+}
 
-  result.inliers = n_in;
-  if (n_in < config_.min_inliers) {
-    return lose(std::to_string(n_in) + " inliers < " + std::to_string(config_.min_inliers));
-  }
-
-  const Eigen::Isometry3d X_WC = X_CW.inverse();
-  velocity_ = X_WC_.inverse() * X_WC;
-  X_WC_ = X_WC;
-  result.X_WC = X_WC;
-  result.status = n_in < config_.weak_inliers ? TrackingStatus::kWeak : TrackingStatus::kOk;
-
+// After a tracked frame: landmark bookkeeping, a keyframe if needed, culling. Returns whether
+// the frame became a keyframe.
+bool RgbdOdometry::updateLocalMap(const Frame& frame, const LocalMapMatches& matches, const PoseEstimate& pose) {
   // Landmark bookkeeping: matched inliers are fresh, expected but unmatched ones age.
   std::vector<bool> seen(landmarks_.size(), false);
-  std::vector<int> matched_landmark(f.keypoints.size(), -1);
-  for (std::size_t m = 0; m < object.size(); ++m) {
-    if (!is_inlier[m]) continue;
-    const int k = match_keypoint[m];
-    const int l = best_landmark[static_cast<std::size_t>(k)];
+  std::vector<int> matched_landmark(frame.features.keypoints.size(), -1);
+  for (std::size_t m = 0; m < matches.object.size(); ++m) {
+    if (!pose.is_inlier[m]) continue;
+    const int k = matches.keypoint[m];
+    const int l = matches.landmark_of[static_cast<std::size_t>(k)];
     seen[static_cast<std::size_t>(l)] = true;
     matched_landmark[static_cast<std::size_t>(k)] = l;
   }
@@ -361,68 +429,40 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     if (seen[l]) {
       landmarks_[l].misses = 0;
       landmarks_[l].last_seen = frame_;
-    } else if (expected[l]) {
+    } else if (matches.expected[l]) {
       ++landmarks_[l].misses;
     }
   }
-
-  // Keyframe: tracking thins out, or the camera moved or turned enough since the last one.
-  const Keyframe& last = keyframes_.back();
-  const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC;
-  const bool need_keyframe = n_in < config_.keyframe_inlier_ratio * last.tracked ||
-                             rel.translation().norm() > config_.keyframe_translation_m ||
-                             rotationAngle(rel.linear()) > config_.keyframe_rotation_rad;
-  if (need_keyframe) {
-    addKeyframe(X_WC, f, p_C, valid, matched_landmark, n_in);
-    result.keyframe = true;
-  }
+  const bool keyframe = needsKeyframe(pose.inliers);
+  if (keyframe) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
   // Cull landmarks that keep failing to match where they should be seen (after the keyframe
   // step, which indexes landmarks_ through matched_landmark).
   landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
                                   [&](const Landmark& lm) { return lm.misses > config_.landmark_max_misses; }),
                    landmarks_.end());
-  history_.push_back(result);
-  return result;
+  return keyframe;
 }
 
-FrameResult RgbdOdometry::initialise(FrameResult result, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
-                                     const std::vector<bool>& valid) {
-  if (result.with_depth < config_.init_min_features) {
-    result.status = TrackingStatus::kLost;
-    result.reason = std::to_string(result.with_depth) + " features with depth < " +
-                    std::to_string(config_.init_min_features) + " to initialise";
-    if (!failed_) {
-      failed_ = true;
-      failed_at_ = result.t_s;
-    }
-    return result;
-  }
-  initialised_ = true;
-  result.reinitialised = !history_.empty();
-  X_WC_ = X_WC0_;
-  velocity_.setIdentity();
-  landmarks_.clear();
-  keyframes_.clear();
-  addKeyframe(X_WC_, f, p_C, valid, std::vector<int>(f.keypoints.size(), -1), 0);
-  result.X_WC = X_WC_;
-  result.status = TrackingStatus::kOk;
-  result.inliers = result.with_depth;
-  result.keyframe = true;
-  return result;
+// Keyframe: tracking thins out, or the camera moved or turned enough since the last one.
+bool RgbdOdometry::needsKeyframe(int inliers) const {
+  const Keyframe& last = keyframes_.back();
+  const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC_;
+  return inliers < config_.keyframe_inlier_ratio * last.tracked ||
+         rel.translation().norm() > config_.keyframe_translation_m ||
+         rotationAngle(rel.linear()) > config_.keyframe_rotation_rad;
 }
 
-void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Features& f,
-                               const std::vector<Eigen::Vector3d>& p_C, const std::vector<bool>& valid,
+void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame,
                                const std::vector<int>& matched_landmark, int tracked) {
   Keyframe kf;
   kf.id = next_keyframe_id_++;
   kf.X_WC = X_WC;
   int created = 0;
-  for (std::size_t i = 0; i < f.keypoints.size(); ++i) {
-    if (!valid[i] || matched_landmark[i] >= 0) continue;  // tracked keypoints already have a landmark
+  for (std::size_t i = 0; i < frame.features.keypoints.size(); ++i) {
+    if (!frame.valid[i] || matched_landmark[i] >= 0) continue;  // tracked keypoints already have a landmark
     Landmark lm;
-    lm.p_W = X_WC * p_C[i];
-    lm.descriptor = descriptorBits(f.descriptors, static_cast<int>(i));
+    lm.p_W = X_WC * frame.p_C[i];
+    lm.descriptor = descriptorBits(frame.features.descriptors, static_cast<int>(i));
     lm.keyframe = kf.id;
     lm.last_seen = frame_;
     landmarks_.push_back(std::move(lm));
@@ -442,6 +482,34 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Features& f,
         std::remove_if(landmarks_.begin(), landmarks_.end(), [&](const Landmark& lm) { return lm.keyframe == gone; }),
         landmarks_.end());
   }
+}
+
+// Lost: the last good pose stands; with reinitialise_after_lost the next frame with enough
+// features starts again from it.
+FrameResult RgbdOdometry::lose(FrameResult result, const std::string& why) {
+  result.status = TrackingStatus::kLost;
+  result.reason = why;
+  result.X_WC = X_WC_;
+  markFailed(result.t_s);
+  if (config_.reinitialise_after_lost) {
+    initialised_ = false;
+    X_WC0_ = X_WC_;  // carry on from the last good pose
+    landmarks_.clear();
+    keyframes_.clear();
+    velocity_.setIdentity();
+  }
+  return record(result);
+}
+
+void RgbdOdometry::markFailed(double t_s) {
+  if (failed_) return;
+  failed_ = true;
+  failed_at_ = t_s;
+}
+
+FrameResult RgbdOdometry::record(const FrameResult& result) {
+  history_.push_back(result);
+  return result;
 }
 
 }  // namespace tgnav::vo

@@ -44,11 +44,40 @@ struct OdometryConfig {
   int landmark_max_misses = 10;         // cull a landmark not matched in this many frames it was expected in
   bool reinitialise_after_lost = false;
 
+  // Names every field once, for the harness's config files (a(key, field), `features` as a
+  // mapping; harness/config/yaml_util.h): configs/vo.yaml.
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("features", features);
+    a("min_depth_m", min_depth_m);
+    a("max_depth_m", max_depth_m);
+    a("depth_edge_m", depth_edge_m);
+    a("init_min_features", init_min_features);
+    a("min_inliers", min_inliers);
+    a("weak_inliers", weak_inliers);
+    a("search_radius_px", search_radius_px);
+    a("max_descriptor_distance", max_descriptor_distance);
+    a("ratio_test", ratio_test);
+    a("ransac_reprojection_px", ransac_reprojection_px);
+    a("ransac_iterations", ransac_iterations);
+    a("ransac_confidence", ransac_confidence);
+    a("local_map_keyframes", local_map_keyframes);
+    a("keyframe_inlier_ratio", keyframe_inlier_ratio);
+    a("keyframe_translation_m", keyframe_translation_m);
+    a("keyframe_rotation_rad", keyframe_rotation_rad);
+    a("landmark_max_misses", landmark_max_misses);
+    a("reinitialise_after_lost", reinitialise_after_lost);
+  }
+
   void validate() const;  // std::invalid_argument naming the field and value
 };
 
 enum class TrackingStatus { kOk, kWeak, kLost };
 const char* toString(TrackingStatus status);
+
+// A tracked frame's status from the inliers of its refined pose: lost below config.min_inliers,
+// weak below config.weak_inliers, ok from there on.
+TrackingStatus decideStatus(int inliers, const OdometryConfig& config);
 
 struct FrameResult {
   double t_s = 0.0;
@@ -91,11 +120,30 @@ class RgbdOdometry {
     Eigen::Isometry3d X_WC;
     int tracked = 0;  // landmarks it tracked or created
   };
+  struct Frame;            // features and their 3D points
+  struct LocalMapMatches;  // landmarks matched to a frame's keypoints
+  struct PoseEstimate;     // PnP RANSAC and its refinement
 
-  FrameResult initialise(FrameResult result, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
-                         const std::vector<bool>& valid);
-  void addKeyframe(const Eigen::Isometry3d& X_WC, const Features& f, const std::vector<Eigen::Vector3d>& p_C,
-                   const std::vector<bool>& valid, const std::vector<int>& matched_landmark, int tracked);
+  // The steps of track, in order (initialise instead of the rest for a first frame, or the
+  // first after a loss with reinitialise_after_lost).
+  void checkFrame(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const;
+  Frame prepareFrame(const cv::Mat& image, const cv::Mat& depth_m) const;
+  FrameResult initialise(FrameResult result, const Frame& frame);
+  Eigen::Isometry3d predictPose() const { return X_WC_ * velocity_; }  // constant-velocity motion model
+  LocalMapMatches matchLocalMap(const Frame& frame, const Eigen::Isometry3d& X_CW_pred) const;
+  PoseEstimate estimatePose(const LocalMapMatches& matches, const Eigen::Isometry3d& X_CW_pred) const;
+  bool updateLocalMap(const Frame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
+  FrameResult lose(FrameResult result, const std::string& why);  // where a step fails
+  // Their parts.
+  bool backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const;
+  int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
+                 const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec, Eigen::Isometry3d* X_CW,
+                 std::vector<bool>* is_inlier) const;
+  bool needsKeyframe(int inliers) const;
+  void addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame, const std::vector<int>& matched_landmark,
+                   int tracked);
+  void markFailed(double t_s);                    // the first loss
+  FrameResult record(const FrameResult& result);  // into history_
 
   CameraIntrinsics camera_;
   OdometryConfig config_;

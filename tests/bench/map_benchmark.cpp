@@ -3,16 +3,17 @@
 
 #include <random>
 
-#include "harness/map_builder.h"
-#include "harness/mujoco_sim.h"
-#include "harness/scene_geometry.h"
+#include "harness/run/map_builder.h"
+#include "harness/sim/mujoco_sim.h"
+#include "harness/sim/scene_geometry.h"
 
 namespace tgnav::harness {
 namespace {
 
 struct SmokeMap {
-  SmokeMap() : scene(loadSceneConfig(std::string(TGNAV_SOURCE_DIR) + "/configs/scenes/smoke.yaml")),
-               map(buildFeatureMap(scene, MapBuildConfig{}, nullptr)) {
+  SmokeMap()
+      : scene(loadSceneConfig(std::string(TGNAV_SOURCE_DIR) + "/configs/scenes/smoke.yaml")),
+        map(buildFeatureMap(scene, MapBuildConfig{}, nullptr)) {
     ModelPtr model = loadModel(scene.mjcf);
     DataPtr data = makeData(model.get());
     mj_forward(model.get(), data.get());
@@ -43,7 +44,8 @@ void BM_VisibleFrom(benchmark::State& state) {
   for (auto _ : state) {
     visible += static_cast<long>(s.map.visibleFrom(s.queries[i++ % s.queries.size()], config).size());
   }
-  state.counters["queries_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["queries_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["landmarks_per_query"] = static_cast<double>(visible) / state.iterations();
 }
 BENCHMARK(BM_VisibleFrom)->Unit(benchmark::kMillisecond)->UseRealTime();

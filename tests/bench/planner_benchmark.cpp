@@ -2,9 +2,9 @@
 // rasterised at 5 cm at flight height: 440 x 400 cells, start and goal from the scene.
 #include <benchmark/benchmark.h>
 
-#include "harness/mujoco_sim.h"
-#include "harness/scene_config.h"
-#include "harness/scene_geometry.h"
+#include "harness/config/scene_config.h"
+#include "harness/sim/mujoco_sim.h"
+#include "harness/sim/scene_geometry.h"
 #include "planner/topological_planner.h"
 #include "planner/trajectory_generator.h"
 

@@ -4,11 +4,11 @@
 #include <cmath>
 
 #include "control/cascade.h"
-#include "harness/camera.h"
-#include "harness/config_io.h"
-#include "harness/flight_loop.h"
-#include "harness/mujoco_sim.h"
-#include "harness/scene_config.h"
+#include "harness/config/config_io.h"
+#include "harness/config/scene_config.h"
+#include "harness/sim/camera.h"
+#include "harness/sim/flight_loop.h"
+#include "harness/sim/mujoco_sim.h"
 
 namespace tgnav::harness {
 namespace {
@@ -43,9 +43,8 @@ void BM_RenderRgbd(benchmark::State& state) {
     setVehiclePose(smoke.model.get(), smoke.data.get(), smoke.ids, pose);
     benchmark::DoNotOptimize(camera.render(smoke.data.get()));
   }
-  state.counters["ms_per_frame"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) / 1000.0,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ms_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations()) / 1000.0,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_RenderRgbd)->Args({320, 240})->Args({640, 480})->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -57,9 +56,8 @@ void BM_PhysicsStep(benchmark::State& state) {
     smoke.data->act[smoke.ids.motor_act[i]] = hover;
   }
   for (auto _ : state) mj_step(smoke.model.get(), smoke.data.get());
-  state.counters["us_per_step"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) / 1e6,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["us_per_step"] = benchmark::Counter(static_cast<double>(state.iterations()) / 1e6,
+                                                     benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_PhysicsStep)->Unit(benchmark::kMicrosecond);
 
@@ -75,9 +73,8 @@ void BM_ControllerCycle(benchmark::State& state) {
     cascade.updateAttitude(s.q_WB);
     benchmark::DoNotOptimize(cascade.updateRate(s.w_B, 0.002));
   }
-  state.counters["us_per_cycle"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) / 1e6,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["us_per_cycle"] = benchmark::Counter(static_cast<double>(state.iterations()) / 1e6,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_ControllerCycle)->Unit(benchmark::kMicrosecond);
 
@@ -97,8 +94,8 @@ void BM_ClosedLoopNoRender(benchmark::State& state) {
     loop.step(sp);
     ++steps;
   }
-  state.counters["real_time_factor"] = benchmark::Counter(static_cast<double>(steps) * smoke.model->opt.timestep,
-                                                          benchmark::Counter::kIsRate);
+  state.counters["real_time_factor"] =
+      benchmark::Counter(static_cast<double>(steps) * smoke.model->opt.timestep, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ClosedLoopNoRender)->Unit(benchmark::kMicrosecond)->UseRealTime();
 

@@ -1,14 +1,15 @@
 // The rendered camera is a metric pinhole camera: depth is true z, the intrinsics derived from
 // the MJCF fovy back-project pixels onto the surfaces they show, and project world points onto
 // the pixels where they appear.
+#include "harness/sim/camera.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
 
-#include "harness/camera.h"
-#include "harness/mujoco_sim.h"
+#include "harness/sim/mujoco_sim.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -21,8 +22,7 @@ constexpr double kWallX = 3.0;                 // front face of the wall
 
 // Rotation of MuJoCo's camera frame in W for a camera looking along yaw/pitch.
 Eigen::Matrix3d mujocoCameraAxes(double yaw, double pitch) {
-  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw),
-                                std::sin(pitch));
+  const Eigen::Vector3d forward(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch));
   const Eigen::Vector3d right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
   const Eigen::Vector3d up = right.cross(forward);
   Eigen::Matrix3d R;
@@ -36,8 +36,8 @@ std::string testScene(double yaw, double pitch) {
   std::ostringstream xml;
   xml.precision(17);
   xml << "<mujoco><visual><global offwidth='640' offheight='480'/></visual><worldbody>"
-      << "<camera name='cam' pos='" << kCameraPos.transpose() << "' xyaxes='"
-      << R.col(0).transpose() << " " << R.col(1).transpose() << "' fovy='60'/>"
+      << "<camera name='cam' pos='" << kCameraPos.transpose() << "' xyaxes='" << R.col(0).transpose() << " "
+      << R.col(1).transpose() << "' fovy='60'/>"
       << "<geom type='box' pos='" << kWallX + 0.1 << " 0 0' size='0.1 40 40' rgba='0.5 0.5 0.5 1'/>"
       << "<geom type='sphere' pos='" << kMarker.transpose() << "' size='0.03' rgba='1 0 0 1'"
       << " material='glow'/>"
@@ -73,8 +73,7 @@ TEST_F(CameraTest, PoseIsComputerVisionConvention) {
   const Eigen::Isometry3d X_WC = camera.pose(data_.get());
   const Eigen::Vector3d forward = X_WC.linear().col(2);
   EXPECT_NEAR(forward.dot(Eigen::Vector3d(std::cos(-8 * kDeg) * std::cos(25 * kDeg),
-                                          std::cos(-8 * kDeg) * std::sin(25 * kDeg),
-                                          std::sin(-8 * kDeg))),
+                                          std::cos(-8 * kDeg) * std::sin(25 * kDeg), std::sin(-8 * kDeg))),
               1.0, 1e-9);
   EXPECT_LT(X_WC.linear().col(1).z(), 0.0);  // image y points down
   EXPECT_NEAR((X_WC.translation() - kCameraPos).norm(), 0.0, 1e-9);

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "harness/tum_sequence.h"
+#include "harness/io/tum_sequence.h"
 #include "test_util.h"
 
 namespace tgnav {
@@ -326,7 +326,7 @@ TEST(CliRecord, RecordsATumSequenceThatVoRuns) {
                               (dir / "flight").string() + " --record " + seq.string() + " --width 160 --height 120");
   ASSERT_EQ(run.rc, 0) << run.output;
   EXPECT_NE(run.output.find("recorded"), std::string::npos) << run.output;
-  EXPECT_FALSE(std::filesystem::exists(seq.string() + ".partial"));
+  EXPECT_EQ(test::stagingLeftIn(dir), 0);
   // 20 Hz over the whole flight, from t = 0 on the ground.
   const double sim_time_s = readJson(dir / "flight" / "tracking.json")["sim_time_s"].get<double>();
   const int frames = dataRows(seq / "rgb.txt");
@@ -403,7 +403,7 @@ TEST(CliRecord, BadRecordingOptionsAreOneLineExit2AndWriteNothing) {
     EXPECT_NE(run.output.find(c.expect), std::string::npos) << run.output;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.args;
     EXPECT_FALSE(std::filesystem::exists(dir / "seq")) << c.args;
-    EXPECT_FALSE(std::filesystem::exists(dir / "seq.partial")) << c.args;
+    EXPECT_EQ(test::stagingLeftIn(dir), 0) << c.args;
   }
   EXPECT_EQ(filesIn(taken), 1);
 }
@@ -459,7 +459,7 @@ TEST(CliVo, BadSequencesAreOneLineExit2AndWriteNothing) {
               std::string::npos)
         << c.name << ": " << run.output;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.name;
-    EXPECT_FALSE(std::filesystem::exists(out.string() + ".partial")) << c.name;
+    EXPECT_EQ(test::stagingLeftIn(out.parent_path()), 0) << c.name;
   }
 }
 

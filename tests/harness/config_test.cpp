@@ -2,16 +2,19 @@
 // file, the line, the key and the value.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
+#include <type_traits>
 
-#include "harness/config_io.h"
-#include "harness/errors.h"
-#include "harness/planner_config.h"
-#include "harness/scenario.h"
-#include "harness/scene_config.h"
-#include "harness/trial_config.h"
-#include "harness/yaml_util.h"
+#include "harness/base/errors.h"
+#include "harness/config/config_io.h"
+#include "harness/config/planner_config.h"
+#include "harness/config/scenario.h"
+#include "harness/config/scene_config.h"
+#include "harness/config/trial_config.h"
+#include "harness/config/yaml_util.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -135,7 +138,7 @@ TEST(SceneFile, UnknownExtensionIsRejected) {
   EXPECT_NE(inputError([&] { loadScene(file); }).find("unknown scene file type"), std::string::npos);
 }
 
-// --- Writer mode: the read functions, run the other way, emit every key ----------------------
+// --- Writer mode: the visits, run on a writer, emit every key --------------------------------
 
 std::string dump(const YAML::Node& node) {
   YAML::Emitter out;
@@ -164,22 +167,24 @@ TEST(ConfigWriter, WritesExactShortestDecimalsAndTypedScalars) {
   bool flag = true;
   std::string name = "front";
   Eigen::Vector3d v(0.15, 1e-6, -3.0);
-  FieldReader::writer(out)
-      .read("tenth", tenth)
-      .read("micro", micro)
-      .read("twenty", twenty)
-      .read("third", third)
-      .read("negative", negative)
-      .read("count", count)
-      .read("flag", flag)
-      .read("name", name)
-      .read("v", v)
-      .section("inner", [](FieldReader r) {
-        double x = 4.0;
-        EXPECT_TRUE(r.writing());
-        r.read("x", x).finish();
-      })
-      .finish();
+  YamlArchive w = YamlArchive::writer(out);
+  w("tenth", tenth);
+  w("micro", micro);
+  w("twenty", twenty);
+  w("third", third);
+  w("negative", negative);
+  w("count", count);
+  w("flag", flag);
+  w("name", name);
+  w("v", v);
+  w.group("inner", [](auto& r) {
+    double x = 4.0;
+    if constexpr (std::is_same_v<std::decay_t<decltype(r)>, YamlArchive>) {
+      EXPECT_TRUE(r.writing());
+    }
+    r("x", x);
+  });
+  w.finish();
   EXPECT_EQ(out["tenth"].Scalar(), "0.1");
   EXPECT_EQ(out["micro"].Scalar(), "1e-06");
   EXPECT_EQ(out["twenty"].Scalar(), "20");
@@ -190,8 +195,8 @@ TEST(ConfigWriter, WritesExactShortestDecimalsAndTypedScalars) {
   EXPECT_EQ(out["name"].Scalar(), "front");
   EXPECT_EQ(out["inner"]["x"].Scalar(), "4");
   EXPECT_NE(dump(out).find("v: [0.15, 1e-06, -3]"), std::string::npos) << dump(out);
-  EXPECT_EQ(keyPaths(out), (std::vector<std::string>{"tenth", "micro", "twenty", "third", "negative", "count",
-                                                     "flag", "name", "v", "inner", "inner.x"}));
+  EXPECT_EQ(keyPaths(out), (std::vector<std::string>{"tenth", "micro", "twenty", "third", "negative", "count", "flag",
+                                                     "name", "v", "inner", "inner.x"}));
 }
 
 // Emits `c`, loads the text back with `load` and emits that: the two texts must be identical.
@@ -205,14 +210,16 @@ Config roundTrip(const Config& c, Load load, const std::filesystem::path& dir) {
 
 TEST(ConfigRoundTrip, CameraDefaultsAndChangedValues) {
   const auto dir = test::tempDir();
-  roundTrip(CameraConfig{}, [](const auto& f) { return loadCameraConfig(f); }, dir);
+  roundTrip(
+      CameraConfig{}, [](const auto& f) { return loadCameraConfig(f); }, dir);
   CameraConfig c;
   c.name = "down";
   c.width_px = 321;
   c.near_clip_m = 0.1 / 3.0;
   c.min_depth_m = 0.1;
   c.depth_noise_sigma_per_m2 = 1e-6;
-  const CameraConfig back = roundTrip(c, [](const auto& f) { return loadCameraConfig(f); }, dir);
+  const CameraConfig back = roundTrip(
+      c, [](const auto& f) { return loadCameraConfig(f); }, dir);
   EXPECT_EQ(back.name, "down");
   EXPECT_EQ(back.width_px, 321);
   EXPECT_EQ(back.near_clip_m, c.near_clip_m);
@@ -221,12 +228,14 @@ TEST(ConfigRoundTrip, CameraDefaultsAndChangedValues) {
 
 TEST(ConfigRoundTrip, CascadeDefaultsAndChangedValues) {
   const auto dir = test::tempDir();
-  roundTrip(control::CascadeConfig{}, [](const auto& f) { return loadCascadeConfig(f); }, dir);
+  roundTrip(
+      control::CascadeConfig{}, [](const auto& f) { return loadCascadeConfig(f); }, dir);
   control::CascadeConfig c;
   c.rate.p = Eigen::Vector3d(0.1 / 3.0, 0.17, 0.21);
   c.position.tilt_max_rad = M_PI / 5;
   c.attitude_rate_hz = 125.0;
-  const control::CascadeConfig back = roundTrip(c, [](const auto& f) { return loadCascadeConfig(f); }, dir);
+  const control::CascadeConfig back = roundTrip(
+      c, [](const auto& f) { return loadCascadeConfig(f); }, dir);
   EXPECT_EQ(back.rate.p, c.rate.p);
   EXPECT_EQ(back.position.tilt_max_rad, c.position.tilt_max_rad);
   EXPECT_EQ(back.attitude_rate_hz, 125.0);
@@ -235,13 +244,15 @@ TEST(ConfigRoundTrip, CascadeDefaultsAndChangedValues) {
 
 TEST(ConfigRoundTrip, OdometryDefaultsAndChangedValues) {
   const auto dir = test::tempDir();
-  roundTrip(vo::OdometryConfig{}, [](const auto& f) { return loadOdometryConfig(f); }, dir);
+  roundTrip(
+      vo::OdometryConfig{}, [](const auto& f) { return loadOdometryConfig(f); }, dir);
   vo::OdometryConfig c;
   c.features.scale_factor = 1.0 + 1.0 / 7.0;
   c.features.max_features = 777;
   c.ransac_confidence = 0.9999;
   c.reinitialise_after_lost = true;
-  const vo::OdometryConfig back = roundTrip(c, [](const auto& f) { return loadOdometryConfig(f); }, dir);
+  const vo::OdometryConfig back = roundTrip(
+      c, [](const auto& f) { return loadOdometryConfig(f); }, dir);
   EXPECT_EQ(back.features.scale_factor, c.features.scale_factor);
   EXPECT_EQ(back.features.max_features, 777);
   EXPECT_EQ(back.ransac_confidence, 0.9999);
@@ -250,7 +261,8 @@ TEST(ConfigRoundTrip, OdometryDefaultsAndChangedValues) {
 
 TEST(ConfigRoundTrip, TrialDefaultsAndChangedValues) {
   const auto dir = test::tempDir();
-  roundTrip(TrialConfig{}, [](const auto& f) { return loadTrialConfig(f); }, dir);
+  roundTrip(
+      TrialConfig{}, [](const auto& f) { return loadTrialConfig(f); }, dir);
   TrialConfig c;
   c.state_source = StateSource::kVo;
   c.pipeline = false;
@@ -258,7 +270,8 @@ TEST(ConfigRoundTrip, TrialDefaultsAndChangedValues) {
   c.flight.diverged_tilt_rad = 1.0 / 3.0;
   c.imu.gyro_bias_rad_s = 1e-4;
   c.estimator.attitude_gain = 0.35;
-  const TrialConfig back = roundTrip(c, [](const auto& f) { return loadTrialConfig(f); }, dir);
+  const TrialConfig back = roundTrip(
+      c, [](const auto& f) { return loadTrialConfig(f); }, dir);
   EXPECT_EQ(back.state_source, StateSource::kVo);
   EXPECT_FALSE(back.pipeline);
   EXPECT_EQ(back.camera_rate_hz, 25.0);
@@ -269,13 +282,15 @@ TEST(ConfigRoundTrip, TrialDefaultsAndChangedValues) {
 
 TEST(ConfigRoundTrip, PlannerDefaultsAndChangedValues) {
   const auto dir = test::tempDir();
-  roundTrip(PlannerSettings{}, [](const auto& f) { return loadPlannerSettings(f); }, dir);
+  roundTrip(
+      PlannerSettings{}, [](const auto& f) { return loadPlannerSettings(f); }, dir);
   PlannerSettings c;
   c.perception.robot_radius_m = 0.35;
   c.perception.visibility.hfov_rad = M_PI / 3;
   c.rrt_star.samples = 1234;
   c.trajectory.max_iterations = 77;
-  const PlannerSettings back = roundTrip(c, [](const auto& f) { return loadPlannerSettings(f); }, dir);
+  const PlannerSettings back = roundTrip(
+      c, [](const auto& f) { return loadPlannerSettings(f); }, dir);
   EXPECT_EQ(back.perception.robot_radius_m, 0.35);
   EXPECT_EQ(back.rrt_star.robot_radius_m, 0.35);  // follows perception's
   EXPECT_EQ(back.trajectory.robot_radius_m, 0.35);
@@ -307,8 +322,7 @@ TEST(ConfigShippedFiles, CameraYamlListsEveryKey) {
 }
 
 TEST(ConfigShippedFiles, ControllerYamlListsEveryKey) {
-  expectShippedDefaults<control::CascadeConfig>("controller.yaml",
-                                                [](const auto& f) { return loadCascadeConfig(f); });
+  expectShippedDefaults<control::CascadeConfig>("controller.yaml", [](const auto& f) { return loadCascadeConfig(f); });
 }
 
 TEST(ConfigShippedFiles, PlannerYamlListsEveryKey) {
@@ -397,11 +411,10 @@ TEST(ConfigOverrides, NestedKeysListsAndScalars) {
   EXPECT_EQ(r["planner"]["rrt_star"]["samples"].Scalar(), "500");
   EXPECT_EQ(r["vo"]["features"]["max_features"].Scalar(), "800");
   EXPECT_EQ(r["trial"]["imu"]["gyro_bias_rad_s"].Scalar(), "0");
-  EXPECT_EQ(keyPaths(r), (std::vector<std::string>{"start", "trial", "trial.state_source", "trial.imu",
-                                                   "trial.imu.gyro_bias_rad_s", "camera", "camera.width_px",
-                                                   "camera.height_px", "planner", "planner.rrt_star",
-                                                   "planner.rrt_star.samples", "vo", "vo.features",
-                                                   "vo.features.max_features"}));
+  EXPECT_EQ(keyPaths(r),
+            (std::vector<std::string>{"start", "trial", "trial.state_source", "trial.imu", "trial.imu.gyro_bias_rad_s",
+                                      "camera", "camera.width_px", "camera.height_px", "planner", "planner.rrt_star",
+                                      "planner.rrt_star.samples", "vo", "vo.features", "vo.features.max_features"}));
   EXPECT_EQ(keyPaths(YamlDoc::fromOverrides({}).root()).size(), 0u);
 }
 
@@ -441,8 +454,9 @@ class ConfigScenario : public ::testing::Test {
  protected:
   void SetUp() override { dir_ = test::tempDir(); }
   std::filesystem::path scenario(const std::string& body) {
-    return test::writeFile(dir_ / "scenario.yaml",
-                           "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
+    return test::writeFile(
+        dir_ / "scenario.yaml",
+        "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
   }
   std::string error(const std::filesystem::path& file, const std::vector<std::string>& set) {
     const YamlDoc overrides = YamlDoc::fromOverrides(set);
@@ -509,20 +523,20 @@ TEST_F(ConfigScenario, LayersDefaultsFileInlineAndOverrides) {
       "trial_config: trial.yaml\ntrial: {camera_rate_hz: 50, flight: {settle_s: 0.5}}\n"
       "vo_config: vo.yaml\ncontroller_config: ctl.yaml\ncontroller: {rates_hz: {position: 50}}\n"
       "planner: {rrt_star: {samples: 300}}\nstart: [-2, 0, 1, 0]\n");
-  const YamlDoc overrides = YamlDoc::fromOverrides({"camera.rgb_noise_sigma=3", "trial.flight.settle_s=0.25",
-                                                    "vo.features.max_features=600", "seed=9", "goal=[2, 1, 1.5, 0.1]",
-                                                    "controller.position.vel_p_xy=2"});
+  const YamlDoc overrides =
+      YamlDoc::fromOverrides({"camera.rgb_noise_sigma=3", "trial.flight.settle_s=0.25", "vo.features.max_features=600",
+                              "seed=9", "goal=[2, 1, 1.5, 0.1]", "controller.position.vel_p_xy=2"});
   const Scenario s = loadScenario(file, &overrides);
   const CameraConfig defaults;
-  EXPECT_EQ(s.camera.width_px, 400);                        // file
-  EXPECT_EQ(s.camera.near_clip_m, 0.06);                    // file
-  EXPECT_EQ(s.camera.height_px, 320);                       // inline over file
-  EXPECT_EQ(s.camera.rgb_noise_sigma, 3.0);                 // --set over inline over file
-  EXPECT_EQ(s.camera.far_clip_m, defaults.far_clip_m);      // default
-  EXPECT_EQ(s.trial.state_source, StateSource::kVo);        // file
-  EXPECT_EQ(s.trial.camera_rate_hz, 50.0);                  // inline
-  EXPECT_EQ(s.trial.flight.hold_s, 3.0);                    // file, in a section
-  EXPECT_EQ(s.trial.flight.settle_s, 0.25);                 // --set
+  EXPECT_EQ(s.camera.width_px, 400);                    // file
+  EXPECT_EQ(s.camera.near_clip_m, 0.06);                // file
+  EXPECT_EQ(s.camera.height_px, 320);                   // inline over file
+  EXPECT_EQ(s.camera.rgb_noise_sigma, 3.0);             // --set over inline over file
+  EXPECT_EQ(s.camera.far_clip_m, defaults.far_clip_m);  // default
+  EXPECT_EQ(s.trial.state_source, StateSource::kVo);    // file
+  EXPECT_EQ(s.trial.camera_rate_hz, 50.0);              // inline
+  EXPECT_EQ(s.trial.flight.hold_s, 3.0);                // file, in a section
+  EXPECT_EQ(s.trial.flight.settle_s, 0.25);             // --set
   EXPECT_EQ(s.trial.goal_radius_m, TrialConfig{}.goal_radius_m);
   EXPECT_EQ(s.vo.min_inliers, 20);
   EXPECT_EQ(s.vo.features.max_features, 600);
@@ -566,8 +580,8 @@ TEST_F(ConfigScenario, SceneOverrideIsRelativeToTheCurrentDirectory) {
 
 TEST_F(ConfigScenario, SectionsDefaultAndMessagesStay) {
   for (const char* name : {"smoke", "storage", "gallery", "corridor"}) {
-    EXPECT_EQ(inputError([&] { loadScenario(test::sourceDir() / "configs/scenarios" / (std::string(name) + ".yaml")); }),
-              "")
+    EXPECT_EQ(
+        inputError([&] { loadScenario(test::sourceDir() / "configs/scenarios" / (std::string(name) + ".yaml")); }), "")
         << name;
   }
   const Scenario s = loadScenario(scenario(""));
@@ -577,9 +591,8 @@ TEST_F(ConfigScenario, SectionsDefaultAndMessagesStay) {
   EXPECT_EQ(dump(toYaml(s.controller)), dump(toYaml(control::CascadeConfig{})));
   EXPECT_EQ(dump(toYaml(s.vo)), dump(toYaml(vo::OdometryConfig{})));
   EXPECT_EQ(dump(toYaml(s.trial)), dump(toYaml(TrialConfig{})));
-  const auto bad_seed = test::writeFile(dir_ / "bad.yaml", "scene: " +
-                                                               (test::sourceDir() / "configs/scenes/smoke.yaml").string() +
-                                                               "\nseed: -1\n");
+  const auto bad_seed = test::writeFile(
+      dir_ / "bad.yaml", "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: -1\n");
   EXPECT_EQ(inputError([&] { loadScenario(bad_seed); }),
             bad_seed.string() + ":2: key 'seed' has value '-1', expected an integer >= 0");
   const auto unknown = scenario("cammera: {}\n");
@@ -639,6 +652,272 @@ TEST_F(ConfigScenario, ResolvedScenarioWithOverridesLoadsBackIdentically) {
   EXPECT_EQ(back.trial.state_source, StateSource::kVo);
   EXPECT_EQ(back.controller.rate.p, Eigen::Vector3d(0.1, 0.1, 0.3));
   EXPECT_EQ(resolvedScenarioYaml(back), text);
+}
+
+// --- Every key is named once, in a visit ---------------------------------------------------------
+
+// An archive that gives every field it visits a value different from the one it had (and, field
+// after field, different from each other).
+class Perturber {
+ public:
+  Perturber& operator()(const std::string&, double& v) {
+    v = v * 1.5 + 0.25 + 0.001 * ++n_;
+    return *this;
+  }
+  Perturber& operator()(const std::string&, int& v) {
+    v += 3 + ++n_;
+    return *this;
+  }
+  Perturber& operator()(const std::string&, bool& v) {
+    v = !v;
+    return *this;
+  }
+  Perturber& operator()(const std::string&, std::string& v) {
+    v += "_" + std::to_string(++n_);
+    return *this;
+  }
+  Perturber& operator()(const std::string&, Eigen::Vector3d& v) {
+    v = v * 1.5 + Eigen::Vector3d(0.1, 0.2, 0.3) / 3.0 + Eigen::Vector3d::Constant(0.001 * ++n_);
+    return *this;
+  }
+  Perturber& operator()(const std::string&, std::vector<double>& v) {
+    for (double& x : v) x = x * 1.5 + 0.125;
+    v.push_back(0.001 * ++n_);
+    return *this;
+  }
+  Perturber& operator()(const std::string&, planner::Pose4& v) {
+    v.p_WB += Eigen::Vector3d(0.5, -0.25, 0.125);
+    v.yaw_rad += 0.001 * ++n_;
+    return *this;
+  }
+  Perturber& operator()(const std::string&, std::filesystem::path& v) {
+    v /= "x" + std::to_string(++n_);
+    return *this;
+  }
+  template <typename Config>
+  Perturber& operator()(const std::string&, Config& c) {
+    c.visit(*this);
+    return *this;
+  }
+  template <typename Fn>
+  Perturber& group(const std::string&, Fn&& visit_group) {
+    visit_group(*this);
+    return *this;
+  }
+  template <typename E>
+  Perturber& choice(const std::string&, E& v, const std::vector<std::pair<std::string, E>>& names) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i].second == v) {
+        v = names[(i + 1) % names.size()].second;
+        return *this;
+      }
+    }
+    return *this;
+  }
+
+ private:
+  int n_ = 0;
+};
+
+// The dotted paths of the scalar (or list) values of `node`, with their text.
+void leaves(const YAML::Node& node, const std::string& context, std::map<std::string, std::string>* out) {
+  for (const auto& kv : node) {
+    const std::string key = joinKey(context, kv.first.as<std::string>());
+    if (kv.second.IsMap()) {
+      leaves(kv.second, key, out);
+    } else {
+      (*out)[key] = dump(kv.second);
+    }
+  }
+}
+
+template <typename Config>
+class ConfigVisit : public ::testing::Test {};
+
+using VisitedConfigs =
+    ::testing::Types<control::PositionControlConfig, control::AttitudeControlConfig, control::RateControlConfig,
+                     control::CascadeConfig, control::EstimatorConfig, vo::FeatureConfig, vo::OdometryConfig,
+                     planner::TopoPlannerConfig, planner::VisibilityConfig, planner::InformationConfig,
+                     planner::SegmentConfig, planner::PoseGraphConfig, planner::SelectionConfig,
+                     planner::PerceptionPlannerConfig, planner::RrtStarConfig, planner::TrajectoryConfig, CameraConfig,
+                     FlightConfig, ImuConfig, TrialConfig, PlannerSettings, SurveyPlan, SceneConfig>;
+TYPED_TEST_SUITE(ConfigVisit, VisitedConfigs);
+
+// Written with every value changed, read back over the defaults, written again: the same text,
+// and every key's value differs from its default (so every key was read into its field).
+TYPED_TEST(ConfigVisit, RoundTripsChangedValues) {
+  TypeParam c;
+  Perturber perturb;
+  c.visit(perturb);
+  const YAML::Node written = toYaml(c);
+  const std::string text = dump(written);
+  const auto file = test::writeFile(test::tempDir() / "config.yaml", text + "\n");
+  const YamlDoc doc = YamlDoc::load(file);
+  TypeParam back;
+  readConfig(YamlArchive(doc, doc.root(), ""), &back);
+  EXPECT_EQ(dump(toYaml(back)), text);
+
+  std::map<std::string, std::string> changed, defaults;
+  leaves(written, "", &changed);
+  leaves(toYaml(TypeParam{}), "", &defaults);
+  ASSERT_EQ(changed.size(), defaults.size());
+  EXPECT_FALSE(changed.empty());
+  for (const auto& [key, value] : changed) EXPECT_NE(value, defaults[key]) << key;
+}
+
+// No mapping names a key twice; toYaml writes exactly the keys the visit names, in its order.
+TYPED_TEST(ConfigVisit, NamesEachKeyOnce) {
+  TypeParam c;
+  KeyLister keys(/*nested=*/true);
+  c.visit(keys);
+  std::map<std::string, int> count;
+  for (const std::string& k : keys.keys()) ++count[k];
+  for (const auto& [key, n] : count) EXPECT_EQ(n, 1) << "key '" << key << "' is named " << n << " times";
+  EXPECT_EQ(keys.keys(), keyPaths(toYaml(c)));
+}
+
+TEST(ConfigVisitKeys, ScenarioSectionsAreNamedOnce) {
+  Scenario s;
+  KeyLister keys(/*nested=*/true);
+  s.visitSections(keys);
+  std::map<std::string, int> count;
+  for (const std::string& k : keys.keys()) ++count[k];
+  for (const auto& [key, n] : count) EXPECT_EQ(n, 1) << key;
+  KeyLister flat;
+  s.visitSections(flat);
+  EXPECT_EQ(flat.keys(), (std::vector<std::string>{"planner", "controller", "camera", "vo", "trial"}));
+}
+
+// The fields that follow perception's are keys of their structs' own visits, and have none in
+// planner.yaml: a file that sets one is refused.
+TEST(ConfigVisitKeys, PlannerSharedFieldsHaveNoKeys) {
+  PlannerSettings p;
+  KeyLister all(/*nested=*/true);
+  p.perception.visit(all);
+  all("rrt_star", p.rrt_star);
+  all("trajectory", p.trajectory);
+  const std::vector<std::string> written = keyPaths(toYaml(p));
+  for (const std::string& key : PlannerSettings::sharedKeys()) {
+    EXPECT_NE(std::find(all.keys().begin(), all.keys().end(), key), all.keys().end()) << key;
+    EXPECT_EQ(std::find(written.begin(), written.end(), key), written.end()) << key;
+  }
+  const auto dir = test::tempDir();
+  const auto rrt =
+      test::writeFile(dir / "rrt.yaml", "robot_radius_m: 0.4\nrrt_star: {samples: 5, robot_radius_m: 1}\n");
+  EXPECT_EQ(inputError([&] { loadPlannerSettings(rrt); }),
+            rrt.string() +
+                ":2: unknown key 'rrt_star.robot_radius_m' (allowed: samples, range_m, goal_bias, goal_tolerance_m, "
+                "distance_weight, perception_weight, c_p_threshold)");
+  const auto topo = test::writeFile(dir / "topo.yaml", "topology: {robot_radius_m: 1}\n");
+  EXPECT_NE(inputError([&] { loadPlannerSettings(topo); })
+                .find("unknown key 'topology.robot_radius_m' (allowed: max_classes, max_expansions, max_length_ratio, "
+                      "min_spur_length_m)"),
+            std::string::npos);
+  const auto traj = test::writeFile(dir / "traj.yaml", "trajectory: {robot_radius_m: 1}\n");
+  EXPECT_NE(inputError([&] { loadPlannerSettings(traj); }).find("unknown key 'trajectory.robot_radius_m'"),
+            std::string::npos);
+  // What they follow.
+  const auto shared = test::writeFile(dir / "shared.yaml",
+                                      "robot_radius_m: 0.4\nslice_half_height_m: 0.2\nvisibility: {max_range_m: 5}\n"
+                                      "information: {epsilon: 0.02}\ntopology: {max_classes: 4}\n");
+  const PlannerSettings s = loadPlannerSettings(shared);
+  EXPECT_EQ(s.rrt_star.robot_radius_m, 0.4);
+  EXPECT_EQ(s.trajectory.robot_radius_m, 0.4);
+  EXPECT_EQ(s.perception.topo.robot_radius_m, 0.4);
+  EXPECT_EQ(s.perception.graph.robot_radius_m, 0.4);
+  EXPECT_EQ(s.rrt_star.slice_half_height_m, 0.2);
+  EXPECT_EQ(s.rrt_star.visibility.max_range_m, 5.0);
+  EXPECT_EQ(s.rrt_star.information.epsilon, 0.02);
+  EXPECT_EQ(s.rrt_star.topo.max_classes, 4);
+}
+
+TEST(ConfigArchive, ChoiceWritesNamesAndRejectsOthers) {
+  TrialConfig t;
+  t.state_source = StateSource::kVo;
+  EXPECT_EQ(toYaml(t)["state_source"].Scalar(), "vo");
+  const auto file = test::writeFile(test::tempDir() / "trial.yaml", "state_source: \"\"\n");
+  EXPECT_NE(
+      inputError([&] { loadTrialConfig(file); }).find("key 'state_source' has value '', expected a non-empty string"),
+      std::string::npos);
+}
+
+TEST(ConfigArchive, RequiredKeysAndUnknownKeysFirst) {
+  const auto dir = test::tempDir();
+  test::writeFile(dir / "world.xml", "<mujoco/>");
+  // A misspelt key is reported as unknown, not as the missing key it was meant to be.
+  const auto typo = test::writeFile(dir / "scene.yaml",
+                                    "mjcf: world.xml\nflight_height_m: 1.0\nstrat: [0, 0, 1, 0]\ngoal: [1, 1, 1, 0]\n"
+                                    "bounds: {min: [-1, -1, 0], max: [2, 2, 3]}\n"
+                                    "survey: {spacing_m: 1.0, heights_m: [0.8], yaw_count: 8, clearance_m: 0.4}\n");
+  EXPECT_EQ(inputError([&] { loadSceneConfig(typo); })
+                .rfind(typo.string() + ":3: unknown key 'strat' (allowed: mjcf, "
+                                       "flight_height_m, start, goal, bounds, survey)",
+                       0),
+            0u);
+  const auto nested = test::writeFile(dir / "scene2.yaml",
+                                      "mjcf: world.xml\nflight_height_m: 1.0\nstart: [0, 0, 1, 0]\ngoal: [1, 1, 1, 0]\n"
+                                      "bounds: {min: [-1, -1, 0]}\n"
+                                      "survey: {spacing_m: 1.0, heights_m: [0.8], yaw_count: 8, clearance_m: 0.4}\n");
+  EXPECT_NE(inputError([&] { loadSceneConfig(nested); }).find(":5: missing required key 'bounds.max'"),
+            std::string::npos)
+      << inputError([&] { loadSceneConfig(nested); });
+  const auto empty = test::writeFile(dir / "scene3.yaml",
+                                     "mjcf: world.xml\nflight_height_m: 1.0\nstart: [0, 0, 1, 0]\ngoal: [1, 1, 1, 0]\n"
+                                     "bounds: {min: [-1, -1, 0], max: [2, 2, 3]}\n"
+                                     "survey: {spacing_m: 1.0, heights_m: [], yaw_count: 8, clearance_m: 0.4}\n");
+  EXPECT_NE(inputError([&] { loadSceneConfig(empty); }).find("key 'survey.heights_m' must be a non-empty list"),
+            std::string::npos);
+}
+
+// --- The built-in defaults of every section -------------------------------------------------
+
+TEST(ConfigDefaults, LoadBackAsTheScenariosSections) {
+  const std::string text = defaultSectionsYaml();
+  EXPECT_EQ(text.rfind("# ", 0), 0u);
+  const YAML::Node doc = YAML::Load(text);
+  EXPECT_EQ(keyPaths(doc).size(),
+            keyPaths(toYaml(PlannerSettings{})).size() + keyPaths(toYaml(control::CascadeConfig{})).size() +
+                keyPaths(toYaml(CameraConfig{})).size() + keyPaths(toYaml(vo::OdometryConfig{})).size() +
+                keyPaths(toYaml(TrialConfig{})).size() + 5u);
+  EXPECT_EQ(dump(doc["planner"]), dump(toYaml(PlannerSettings{})));
+  EXPECT_EQ(dump(doc["controller"]), dump(toYaml(control::CascadeConfig{})));
+  EXPECT_EQ(dump(doc["camera"]), dump(toYaml(CameraConfig{})));
+  EXPECT_EQ(dump(doc["vo"]), dump(toYaml(vo::OdometryConfig{})));
+  EXPECT_EQ(dump(doc["trial"]), dump(toYaml(TrialConfig{})));
+
+  // A scenario of a scene, a seed and these sections is the scenario with the built-in settings.
+  const auto dir = test::tempDir();
+  const auto file =
+      test::writeFile(dir / "defaults.yaml",
+                      "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + text);
+  const Scenario s = loadScenario(file);
+  const Scenario plain = loadScenario(test::writeFile(
+      dir / "plain.yaml", "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n"));
+  expectSameScenario(s, plain);
+  EXPECT_EQ(resolvedScenarioYaml(s), resolvedScenarioYaml(plain));
+  // ... and the resolved config.yaml holds them, byte for byte.
+  const std::string body = text.substr(text.find("\nplanner:\n") + 1);
+  EXPECT_NE(resolvedScenarioYaml(s).find(body), std::string::npos);
+}
+
+TEST(ConfigDefaults, ListEveryKeyOfTheShippedFiles) {
+  const YAML::Node defaults = YAML::Load(defaultSectionsYaml());
+  for (const auto& [section, file] : std::vector<std::pair<std::string, std::string>>{{"trial", "trial.yaml"},
+                                                                                      {"vo", "vo.yaml"},
+                                                                                      {"camera", "camera.yaml"},
+                                                                                      {"controller", "controller.yaml"},
+                                                                                      {"planner", "planner.yaml"}}) {
+    const std::vector<std::string> listed = keyPaths(defaults[section]);
+    const YAML::Node shipped = YAML::LoadFile((test::sourceDir() / "configs" / file).string());
+    std::map<std::string, std::string> shipped_leaves, listed_leaves;
+    leaves(shipped, "", &shipped_leaves);
+    leaves(defaults[section], "", &listed_leaves);
+    for (const std::string& key : keyPaths(shipped)) {
+      EXPECT_NE(std::find(listed.begin(), listed.end(), key), listed.end()) << file << ": " << key;
+      // A mapping in the file is a mapping in the defaults, a value a value.
+      EXPECT_EQ(shipped_leaves.count(key), listed_leaves.count(key)) << file << ": " << key;
+    }
+  }
 }
 
 }  // namespace

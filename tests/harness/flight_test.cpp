@@ -5,9 +5,9 @@
 #include <cmath>
 #include <iostream>
 
-#include "harness/config_io.h"
-#include "harness/flight_loop.h"
-#include "harness/scene_config.h"
+#include "harness/config/config_io.h"
+#include "harness/config/scene_config.h"
+#include "harness/sim/flight_loop.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -115,8 +115,8 @@ TEST_F(FlightTest, OneMetreStepSettlesWithin3sAndOvershootsLessThan15Percent) {
       overshoot = std::max(overshoot, p[axis] - target[axis]);
       if ((p - target).norm() > 0.05) last_outside = loop_->time();
     }
-    std::cout << "[ figure   ] 1 m step on axis " << axis << ": overshoot " << overshoot
-              << " m, within 5 cm after " << last_outside << " s\n";
+    std::cout << "[ figure   ] 1 m step on axis " << axis << ": overshoot " << overshoot << " m, within 5 cm after "
+              << last_outside << " s\n";
     EXPECT_LT(overshoot, 0.15) << "axis " << axis;
     EXPECT_LT(last_outside, 3.0) << "axis " << axis;
   }
@@ -128,12 +128,13 @@ TEST_F(FlightTest, OneMetreStepSettlesWithin3sAndOvershootsLessThan15Percent) {
 control::SetpointTrajectory figureEight(const Eigen::Vector3d& centre, double laps, double ramp_s) {
   const double a = 2.0;
   const double b = 1.0;
-  const double w = 1.0 / std::sqrt(a * a + 4 * b * b);  // peak phase rate
-  const double cruise_s = laps * 2 * M_PI / w - ramp_s;   // each ramp covers half its phase
+  const double w = 1.0 / std::sqrt(a * a + 4 * b * b);   // peak phase rate
+  const double cruise_s = laps * 2 * M_PI / w - ramp_s;  // each ramp covers half its phase
   const double total_s = cruise_s + 2 * ramp_s;
   auto smooth = [](double u) { return u * u * (3 - 2 * u); };
   auto rate = [&](double t) {  // phase rate and its derivative
-    if (t < ramp_s) return std::pair<double, double>{w * smooth(t / ramp_s), w * 6 * (t / ramp_s) * (1 - t / ramp_s) / ramp_s};
+    if (t < ramp_s)
+      return std::pair<double, double>{w * smooth(t / ramp_s), w * 6 * (t / ramp_s) * (1 - t / ramp_s) / ramp_s};
     if (t > total_s - ramp_s) {
       const double u = (total_s - t) / ramp_s;
       return std::pair<double, double>{w * smooth(u), -w * 6 * u * (1 - u) / ramp_s};
@@ -211,11 +212,13 @@ TEST_F(FlightTest, LateralPushOf1NRejectedWithin2s) {
   for (int i = 0; i < 1500; ++i) {
     ASSERT_TRUE(loop_->step(at(p)));
     const double e = (loop_->state().p_WB - p).norm();
-    if (e > 0.05) back_at = -1.0;
-    else if (back_at < 0.0) back_at = i * model_->opt.timestep;
+    if (e > 0.05)
+      back_at = -1.0;
+    else if (back_at < 0.0)
+      back_at = i * model_->opt.timestep;
   }
-  std::cout << "[ figure   ] 1 N push for 1 s: max deviation " << worst << " m, back within 5 cm "
-            << back_at << " s after release\n";
+  std::cout << "[ figure   ] 1 N push for 1 s: max deviation " << worst << " m, back within 5 cm " << back_at
+            << " s after release\n";
   EXPECT_GT(worst, 0.02) << "the push must move the vehicle";
   EXPECT_LT(worst, 0.3);
   ASSERT_GE(back_at, 0.0) << "never back within 5 cm";

@@ -1,6 +1,6 @@
 // Grid map loaders: exact cells (image row 0 is the top of the map), map_server thresholds with
 // unknown stored as occupied, and one-line InputErrors naming the file and the offending value.
-#include "harness/grid_io.h"
+#include "harness/io/grid_io.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/errors.h"
+#include "harness/base/errors.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -37,8 +37,8 @@ std::string replaced(std::string text, const std::string& from, const std::strin
 
 // 3x2, top row black / near-white / map_server's unknown grey (occ 0.196..0.65 is unknown),
 // bottom row white / mid grey (occ 0.61: unknown) / light grey (occ 0.02: free).
-const std::string kP5 = std::string("P5\n# a comment\n3 2\n255\n") + '\x00' + '\xfe' + '\xcd' +
-                        '\xff' + '\x64' + '\xfa';
+const std::string kP5 =
+    std::string("P5\n# a comment\n3 2\n255\n") + '\x00' + '\xfe' + '\xcd' + '\xff' + '\x64' + '\xfa';
 const std::string kYaml =
     "image: map.pgm\nresolution: 0.05\norigin: [-1.5, 2.0, 0.0]\noccupied_thresh: 0.65\n"
     "free_thresh: 0.196\nnegate: 0\n";
@@ -74,8 +74,7 @@ TEST_F(RosMap, BinaryPgmGivesExactCellsWithTopRowAtLargestY) {
 
 TEST_F(RosMap, AsciiPgmScalesThresholdsWithMaxval) {
   // maxval 15: 15 free, 0 occupied, 8 (occ 0.47) unknown, 14 (occ 0.07) free.
-  const auto file =
-      write(kYaml + "mode: trinary\n", "P2\n# comment\n2 # inline comment\n2\n15\n15 0\n8 14\n");
+  const auto file = write(kYaml + "mode: trinary\n", "P2\n# comment\n2 # inline comment\n2\n15\n15 0\n8 14\n");
   EXPECT_EQ(drawn(loadRosMap(file)), (std::vector<std::string>{".#", "#."}));
 }
 
@@ -213,8 +212,7 @@ TEST_F(RosMap, MaxvalAbove255IsRejected) {
 TEST_F(RosMap, PixelAboveMaxvalIsRejected) {
   const std::string msg = pgmError("P2\n2 1\n15\n3 16\n");
   EXPECT_NE(msg.find(pgmName()), std::string::npos) << msg;
-  EXPECT_NE(msg.find("pixel 1 (row 0, column 1) has value '16' > maxval 15"), std::string::npos)
-      << msg;
+  EXPECT_NE(msg.find("pixel 1 (row 0, column 1) has value '16' > maxval 15"), std::string::npos) << msg;
   const std::string word = pgmError("P2\n2 1\n15\n3 x\n");
   EXPECT_NE(word.find("pixel 1 has value 'x'"), std::string::npos) << word;
 }
@@ -246,8 +244,7 @@ TEST_F(MovingAiMap, SampleGivesExactCellsWithTopRowAtLargestY) {
 }
 
 TEST_F(MovingAiMap, CrlfLineEndsAndTrailingBlankLinesAreAccepted) {
-  const auto file =
-      test::writeFile(dir_ / "m.map", "type octile\r\nheight 1\r\nwidth 2\r\nmap\r\n.@\r\n\r\n");
+  const auto file = test::writeFile(dir_ / "m.map", "type octile\r\nheight 1\r\nwidth 2\r\nmap\r\n.@\r\n\r\n");
   EXPECT_EQ(drawn(loadMovingAiMap(file, 1.0)), (std::vector<std::string>{".#"}));
 }
 

@@ -4,8 +4,8 @@
 
 #include <Eigen/Geometry>
 
-#include "harness/mujoco_sim.h"
-#include "harness/scene_config.h"
+#include "harness/config/scene_config.h"
+#include "harness/sim/mujoco_sim.h"
 #include "test_util.h"
 
 namespace tgnav::harness {

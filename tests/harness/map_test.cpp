@@ -6,10 +6,10 @@
 #include <algorithm>
 #include <iostream>
 
-#include "harness/map_builder.h"
+#include "harness/run/map_builder.h"
+#include "harness/sim/mujoco_sim.h"
+#include "harness/sim/scene_geometry.h"
 #include "planner/occupancy_grid.h"
-#include "harness/mujoco_sim.h"
-#include "harness/scene_geometry.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -88,8 +88,7 @@ TEST_F(SmokeMapTest, OccupancyAgreesWithTheGeometryAtFlightHeight) {
           n[axis] += sign * res;
           Eigen::Vector3d behind = c;
           behind[axis] -= sign * res;
-          if (geometry_->signedDistance(n) > 0.0 || !insideBounds(behind) ||
-              geometry_->signedDistance(behind) <= 0.0) {
+          if (geometry_->signedDistance(n) > 0.0 || !insideBounds(behind) || geometry_->signedDistance(behind) <= 0.0) {
             continue;
           }
           ++surface;
@@ -150,8 +149,8 @@ TEST_F(SmokeMapTest, TexturedCratesCarryLandmarksThePlainPillarNone) {
 TEST_F(SmokeMapTest, FlightHeightSliceMatchesTheGeometry) {
   const double res = 0.1;
   const double z = scene_->flight_height_m;
-  const planner::OccupancyGrid2D grid =
-      planner::sliceOccupancy(*map_, scene_->bounds_min_m.head<2>(), scene_->bounds_max_m.head<2>(), z - 0.3, z + 0.3, res);
+  const planner::OccupancyGrid2D grid = planner::sliceOccupancy(*map_, scene_->bounds_min_m.head<2>(),
+                                                                scene_->bounds_max_m.head<2>(), z - 0.3, z + 0.3, res);
   int wrong_free = 0, wrong_occupied = 0, free_cells = 0, solid_cells = 0;
   for (int iy = 0; iy < grid.height; ++iy) {
     for (int ix = 0; ix < grid.width; ++ix) {

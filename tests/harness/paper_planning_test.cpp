@@ -5,7 +5,7 @@
 
 #include <iostream>
 
-#include "harness/plan_run.h"
+#include "harness/run/plan_run.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -53,21 +53,20 @@ TEST(PaperPlanning, StorageProposedTakesTheTexturedLowerClassAgnosticTheUpper) {
   int lower = 0;
   double time_sum = 0.0;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    const PlanRun run = runPlanner(scenario, map, PlannerName::kProposed, static_cast<std::uint64_t>(seed), 0);
-    ASSERT_EQ(run.report.plan.status, planner::PlanStatus::kSolved) << "seed " << seed;
-    ASSERT_EQ(run.report.plan.candidates.size(), 2u);
-    lower += meanYAtPartition(run.report.plan.path) < 0.0;
+    const PlanRun run = runPlanner(scenario, map, planner::PlannerKind::kProposed, static_cast<std::uint64_t>(seed), 0);
+    ASSERT_EQ(run.plan.status, planner::PlanStatus::kSolved) << "seed " << seed;
+    ASSERT_EQ(run.plan.candidates.size(), 2u);
+    lower += meanYAtPartition(run.plan.path) < 0.0;
     time_sum += run.plan_time_s();
-    const auto& chosen = run.report.plan.candidates[static_cast<std::size_t>(run.report.plan.chosen)];
+    const auto& chosen = run.plan.candidates[static_cast<std::size_t>(run.plan.chosen)];
     EXPECT_GT(chosen.c_p_min, scenario.planner.perception.selection.c_p_threshold) << "seed " << seed;
   }
-  const PlanRun ap = runPlanner(scenario, map, PlannerName::kAgnostic, 1, 0);
-  ASSERT_EQ(ap.report.plan.status, planner::PlanStatus::kSolved);
-  const double ap_y = meanYAtPartition(ap.report.plan.path);
+  const PlanRun ap = runPlanner(scenario, map, planner::PlannerKind::kAgnostic, 1, 0);
+  ASSERT_EQ(ap.plan.status, planner::PlanStatus::kSolved);
+  const double ap_y = meanYAtPartition(ap.plan.path);
   std::cout << "[ figure   ] storage: proposed took the lower (textured) class for " << lower << "/" << kSeeds
-            << " seeds, mean plan time " << time_sum / kSeeds << " s; AP's path passes the partition at mean y "
-            << ap_y << " m, " << ap.report.plan.candidates[static_cast<std::size_t>(ap.report.plan.chosen)].length_m
-            << " m\n";
+            << " seeds, mean plan time " << time_sum / kSeeds << " s; AP's path passes the partition at mean y " << ap_y
+            << " m, " << ap.plan.candidates[static_cast<std::size_t>(ap.plan.chosen)].length_m << " m\n";
   EXPECT_EQ(lower, kSeeds);
   EXPECT_GT(ap_y, 0.0);
 }
@@ -76,27 +75,25 @@ TEST(PaperPlanning, GalleryProposedAvoidsBothTexturePoorCorridors) {
   const Scenario scenario = loadScenario(test::sourceDir() / "configs/scenarios/gallery.yaml");
   const planner::FeatureMap map = test::sceneMap("gallery");
   // The poor corridors (models/scenes/gallery.xml) without their mouths at the central crossing.
-  const Eigen::Vector2d h_lo(1.8, 0.0), h_hi(7.5, 2.4);    // horizontal, right of the centre
-  const Eigen::Vector2d v_lo(-1.7, 3.4), v_hi(0.8, 7.0);   // longitudinal, upper middle
+  const Eigen::Vector2d h_lo(1.8, 0.0), h_hi(7.5, 2.4);   // horizontal, right of the centre
+  const Eigen::Vector2d v_lo(-1.7, 3.4), v_hi(0.8, 7.0);  // longitudinal, upper middle
   int avoided = 0;
   double time_sum = 0.0;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    const PlanRun run = runPlanner(scenario, map, PlannerName::kProposed, static_cast<std::uint64_t>(seed), 0);
-    ASSERT_EQ(run.report.plan.status, planner::PlanStatus::kSolved) << "seed " << seed;
-    avoided += metresInside(run.report.plan.path, h_lo, h_hi) == 0.0 &&
-               metresInside(run.report.plan.path, v_lo, v_hi) == 0.0;
+    const PlanRun run = runPlanner(scenario, map, planner::PlannerKind::kProposed, static_cast<std::uint64_t>(seed), 0);
+    ASSERT_EQ(run.plan.status, planner::PlanStatus::kSolved) << "seed " << seed;
+    avoided += metresInside(run.plan.path, h_lo, h_hi) == 0.0 && metresInside(run.plan.path, v_lo, v_hi) == 0.0;
     time_sum += run.plan_time_s();
   }
-  const PlanRun ap = runPlanner(scenario, map, PlannerName::kAgnostic, 1, 0);
-  ASSERT_EQ(ap.report.plan.status, planner::PlanStatus::kSolved);
-  const double ap_h = metresInside(ap.report.plan.path, h_lo, h_hi);
-  const double ap_v = metresInside(ap.report.plan.path, v_lo, v_hi);
+  const PlanRun ap = runPlanner(scenario, map, planner::PlannerKind::kAgnostic, 1, 0);
+  ASSERT_EQ(ap.plan.status, planner::PlanStatus::kSolved);
+  const double ap_h = metresInside(ap.plan.path, h_lo, h_hi);
+  const double ap_v = metresInside(ap.plan.path, v_lo, v_hi);
   std::cout << "[ figure   ] gallery: proposed avoided both texture-poor corridors for " << avoided << "/" << kSeeds
-            << " seeds, mean plan time " << time_sum / kSeeds << " s; AP ("
-            << ap.report.topo.classes.size() << " classes) flies " << ap_h << " m and " << ap_v
-            << " m inside them\n";
+            << " seeds, mean plan time " << time_sum / kSeeds << " s; AP (" << ap.plan.topo.classes.size()
+            << " classes) flies " << ap_h << " m and " << ap_v << " m inside them\n";
   EXPECT_EQ(avoided, kSeeds);
-  EXPECT_EQ(ap.report.topo.classes.size(), 10u);
+  EXPECT_EQ(ap.plan.topo.classes.size(), 10u);
   EXPECT_GT(ap_h + ap_v, 3.0);
 }
 

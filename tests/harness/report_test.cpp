@@ -3,7 +3,7 @@
 // planner names), its CSV and Markdown forms, the refusal of bad input with file:line and column,
 // and the command end to end: nothing written on bad input, tables kept when the plots fail, and
 // (where matplotlib is installed) the figures.
-#include "harness/report.h"
+#include "harness/experiments/report.h"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 
 #include <iostream>
 
-#include "harness/map_builder.h"
+#include "harness/run/map_builder.h"
 #include "test_util.h"
 
 namespace tgnav::harness {

@@ -4,9 +4,9 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "harness/camera.h"
-#include "harness/mujoco_sim.h"
-#include "harness/scene_config.h"
+#include "harness/config/scene_config.h"
+#include "harness/sim/camera.h"
+#include "harness/sim/mujoco_sim.h"
 #include "test_util.h"
 #include "vo/features.h"
 
@@ -27,8 +27,8 @@ class SceneTextureTest : public ::testing::Test {
     planner::Pose4 pose;
     pose.p_WB = Eigen::Vector3d(x, y, z);
     setVehiclePose(model_.get(), data_.get(), ids_, pose);
-    const Eigen::Quaterniond q = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) *
-                                 Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY());
+    const Eigen::Quaterniond q =
+        Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch_rad, Eigen::Vector3d::UnitY());
     mjtNum* qpos = data_->qpos + ids_.qpos_adr + 3;
     qpos[0] = q.w();
     qpos[1] = q.x();
@@ -56,9 +56,7 @@ TEST_F(SceneTextureTest, TexturedCratesGiveManyKeypoints) {
   EXPECT_GT(keypointsFrom(0.0, 0.3, 1.0, M_PI / 2), 300);
 }
 
-TEST_F(SceneTextureTest, PlainFloorGivesAlmostNone) {
-  EXPECT_LT(keypointsFrom(-2.0, -1.0, 1.2, 0.0, M_PI / 2), 30);
-}
+TEST_F(SceneTextureTest, PlainFloorGivesAlmostNone) { EXPECT_LT(keypointsFrom(-2.0, -1.0, 1.2, 0.0, M_PI / 2), 30); }
 
 TEST_F(SceneTextureTest, PlainPillarGivesAlmostNone) {
   // 0.4 m in front of the pillar's west face: it fills the view.

@@ -7,11 +7,11 @@
 
 #include <iostream>
 
-#include "harness/flight_loop.h"
-#include "harness/mujoco_sim.h"
-#include "harness/plan_run.h"
-#include "harness/scene_geometry.h"
-#include "harness/trajectory_csv.h"
+#include "harness/io/trajectory_csv.h"
+#include "harness/run/plan_run.h"
+#include "harness/sim/flight_loop.h"
+#include "harness/sim/mujoco_sim.h"
+#include "harness/sim/scene_geometry.h"
 #include "planner/topological_planner.h"
 #include "test_util.h"
 
@@ -53,21 +53,21 @@ Checked checkTrajectory(const Scenario& scenario, const PlanRun& run, const std:
   EXPECT_GE(c.min_clearance, config.margin_m()) << what;
   // Same homology class as the planned path and as the topological class it was chosen from.
   std::vector<Eigen::Vector2d> path_xy;
-  for (const auto& p : run.report.plan.path) path_xy.push_back(p.p_WB.head<2>());
-  const auto& obstacles = run.report.topo.obstacle_points;
+  for (const auto& p : run.plan.path) path_xy.push_back(p.p_WB.head<2>());
+  const auto& obstacles = run.plan.topo.obstacle_points;
   const std::vector<double> h_traj = planner::windingAngles(xy, obstacles);
   EXPECT_TRUE(planner::TopologicalPlanner::sameClass(h_traj, planner::windingAngles(path_xy, obstacles))) << what;
   EXPECT_TRUE(tr.same_homology) << what;
-  if (run.chosen_topology_class >= 0) {
+  if (run.plan.chosen_class >= 0) {
     EXPECT_TRUE(planner::TopologicalPlanner::sameClass(
-        h_traj, run.report.topo.classes[static_cast<std::size_t>(run.chosen_topology_class)].h_signature))
+        h_traj, run.plan.topo.classes[static_cast<std::size_t>(run.plan.chosen_class)].h_signature))
         << what;
   }
   // Rest to rest, from the start to the path's end.
   const planner::TrajectorySample a = traj.at(0.0);
   const planner::TrajectorySample b = traj.at(traj.duration());
   EXPECT_LT((a.p_W - scenario.scene.start.p_WB).norm(), 1e-6) << what;
-  EXPECT_LT((b.p_W - run.report.plan.path.back().p_WB).norm(), 1e-6) << what;
+  EXPECT_LT((b.p_W - run.plan.path.back().p_WB).norm(), 1e-6) << what;
   EXPECT_LT(a.v_W.norm() + b.v_W.norm() + a.a_W.norm() + b.a_W.norm(), 1e-9) << what;
   return c;
 }
@@ -76,17 +76,17 @@ void checkScene(const std::string& name) {
   const Scenario scenario = loadScenario(test::sourceDir() / "configs/scenarios" / (name + ".yaml"));
   const planner::FeatureMap map = test::sceneMap(name);
   struct Case {
-    PlannerName planner;
+    planner::PlannerKind planner;
     std::uint64_t seed;
   };
-  for (const Case& k :
-       {Case{PlannerName::kProposed, 1}, Case{PlannerName::kProposed, 2}, Case{PlannerName::kProposed, 3},
-        Case{PlannerName::kAgnostic, 1}, Case{PlannerName::kRrtStar, 1}}) {
+  for (const Case& k : {Case{planner::PlannerKind::kProposed, 1}, Case{planner::PlannerKind::kProposed, 2},
+                        Case{planner::PlannerKind::kProposed, 3}, Case{planner::PlannerKind::kAgnostic, 1},
+                        Case{planner::PlannerKind::kRrtStar, 1}}) {
     const PlanRun run = runPlanner(scenario, map, k.planner, k.seed, 0);
-    ASSERT_EQ(run.report.plan.status, planner::PlanStatus::kSolved);
+    ASSERT_EQ(run.plan.status, planner::PlanStatus::kSolved);
     const std::string what = name + " " + toString(k.planner) + " seed " + std::to_string(k.seed);
     const Checked c = checkTrajectory(scenario, run, what);
-    std::cout << "[ figure   ] " << what << ": path " << run.report.plan.candidates[run.report.plan.chosen].length_m
+    std::cout << "[ figure   ] " << what << ": path " << run.plan.candidates[run.plan.chosen].length_m
               << " m -> trajectory " << run.trajectory.length_m << " m, " << run.trajectory.duration_s
               << " s; 1 kHz: min clearance " << c.min_clearance << " m, max |v| " << c.max_speed << " m/s, max |a| "
               << c.max_accel << " m/s^2, max |yaw rate| " << c.max_yaw_rate << " rad/s; " << run.trajectory.iterations
@@ -102,7 +102,7 @@ TEST(SceneTrajectory, GalleryPlannersGiveFeasibleClearSameClassTrajectories) { c
 TEST(SceneTrajectory, StorageProposedTrajectoryRoundTripsAndIsFlownClearOfTheScene) {
   const Scenario scenario = loadScenario(test::sourceDir() / "configs/scenarios/storage.yaml");
   const planner::FeatureMap map = test::sceneMap("storage");
-  const PlanRun run = runPlanner(scenario, map, PlannerName::kProposed, 1, 0);
+  const PlanRun run = runPlanner(scenario, map, planner::PlannerKind::kProposed, 1, 0);
   ASSERT_TRUE(run.trajectory.trajectory) << run.trajectory.reason;
   const control::SetpointTrajectory written = setpoints(run, scenario.planner.trajectory.sample_rate_hz);
   const auto csv = test::writeFile(test::tempDir() / "trajectory.csv", trajectoryCsv(written));

@@ -1,13 +1,22 @@
 // Sweep files: expansion into trials, their ids and arguments, the checks of bad sweeps, the
 // manifest, and how trial folders are judged (absent, interrupted, corrupted, done) for resuming.
-#include "harness/sweep.h"
+// Then runSweep and sweepStatus without the CLI, with stand-ins for `tgnav trial`, sbatch and
+// squeue: the local pool, resuming, failures, tidying, and the Slurm backend's submissions.
+#include "harness/experiments/sweep.h"
 
 #include <gtest/gtest.h>
+#include <stdlib.h>
 
+#include <exception>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <set>
+#include <sstream>
 
-#include "harness/shell.h"
+#include "harness/base/shell.h"
+#include "harness/experiments/sweep_folder.h"
+#include "harness/experiments/sweep_runner.h"
 #include "tests/harness/test_util.h"
 
 namespace tgnav::harness {
@@ -250,6 +259,240 @@ TEST(SweepFolder, IndexHasEachFinishedTrialOnceInManifestOrder) {
             "trials/smoke__rrtstar-300__s01");
   EXPECT_EQ(lines[2].substr(0, 50), "smoke__rrtstar-300__s03,smoke,rrtstar,300,3,,vo_lo");
   EXPECT_NE(lines[2].find(",vo_lost,7.5,7.0,,0.01,"), std::string::npos) << lines[2];  // no goal error
+}
+
+// ---- running sweeps -------------------------------------------------------------------------
+
+std::string readText(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path executable(const fs::path& file, const std::string& text) {
+  test::writeFile(file, text);
+  fs::permissions(file, fs::perms::owner_all, fs::perm_options::add);
+  return file;
+}
+
+// A stand-in for the tgnav program: `trial ... --seed K --out DIR` writes the metrics.json of a
+// finished trial into DIR; the seed in $FAKE_FAIL_SEED fails instead (exit 3).
+fs::path fakeTgnav(const fs::path& dir) {
+  return executable(dir / "fake_tgnav",
+                    "#!/bin/bash\n"
+                    "while [ $# -gt 0 ]; do case $1 in --out) out=$2 ;; --seed) seed=$2 ;; esac; shift; done\n"
+                    "[ \"$seed\" = \"${FAKE_FAIL_SEED:-}\" ] && { echo \"boom: seed $seed\" >&2; exit 3; }\n"
+                    "mkdir -p \"$out\" && cat > \"$out/metrics.json\" <<EOF\n" +
+                        metricsJson("success", "0.05", "$seed") + "\nEOF\n");
+}
+
+// A sweep of `seeds` smoke trials (rrtstar-300) into dir/out, run by the stand-in.
+SweepOptions smokeSweep(const fs::path& dir, int seeds) {
+  SweepOptions o;
+  o.sweep = sweepFile(dir, "seeds: " + std::to_string(seeds) +
+                               "\nruns:\n  - {scenario: SC/smoke.yaml, planner: rrtstar, samples: 300}\n")
+                .string();
+  o.out = (dir / "out").string();
+  o.jobs = 2;
+  o.map_cache = TGNAV_TEST_CACHE;
+  o.program = fakeTgnav(dir);
+  return o;
+}
+
+// The trial ids in index.csv, in order.
+std::vector<std::string> indexIds(const fs::path& out) {
+  std::istringstream in(readText(out / "index.csv"));
+  std::vector<std::string> ids;
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, kIndexHeader);
+  while (std::getline(in, line)) ids.push_back(line.substr(0, line.find(',')));
+  return ids;
+}
+
+// An environment variable set for one scope (unset after it when it was unset or empty before).
+struct ScopedEnv {
+  ScopedEnv(const char* n, const std::string& v) : name(n), old(getenv(n) ? getenv(n) : "") { setenv(n, v.c_str(), 1); }
+  ~ScopedEnv() { old.empty() ? unsetenv(name) : setenv(name, old.c_str(), 1); }
+  const char* name;
+  std::string old;
+};
+
+// What fn() returns (rc) and prints (out, err); an exception passes through (the printing is dropped).
+struct Captured {
+  int rc = -1;
+  std::string out, err;
+};
+Captured capture(const std::function<int()>& fn) {
+  testing::internal::CaptureStdout();
+  testing::internal::CaptureStderr();
+  Captured c;
+  std::exception_ptr error;
+  try {
+    c.rc = fn();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  c.out = testing::internal::GetCapturedStdout();
+  c.err = testing::internal::GetCapturedStderr();
+  if (error) std::rethrow_exception(error);
+  return c;
+}
+
+TEST(SweepFolder, StagingNamesAreThoseOfTgnavTrial) {
+  EXPECT_TRUE(isTrialStaging(".smoke__rrtstar-300__s01.tmp-1234"));
+  EXPECT_FALSE(isTrialStaging(".smoke__rrtstar-300__s01.old-1234"));
+  EXPECT_TRUE(isTrialLeftover(".smoke__rrtstar-300__s01.tmp-1234"));
+  EXPECT_TRUE(isTrialLeftover(".smoke__rrtstar-300__s01.old-1234"));
+  for (const char* name : {"smoke__rrtstar-300__s01", ".", ".keep", "smoke.tmp-12"}) {
+    EXPECT_FALSE(isTrialStaging(name)) << name;
+    EXPECT_FALSE(isTrialLeftover(name)) << name;
+  }
+}
+
+TEST(SweepRunner, OptionsAreCheckedBeforeAnythingIsWritten) {
+  const fs::path dir = test::tempDir();
+  const SweepOptions good = smokeSweep(dir, 1);
+  const std::pair<void (*)(SweepOptions*), const char*> cases[] = {
+      {[](SweepOptions* o) { o->out.clear(); }, "--out: required"},
+      {[](SweepOptions* o) { o->sweep.clear(); }, "--sweep: required (or --status)"},
+      {[](SweepOptions* o) { o->backend = "pbs"; }, "--backend: 'pbs' is not local or slurm"},
+      {[](SweepOptions* o) { o->jobs = -1; }, "--jobs: -1 must be >= 1"},
+      {[](SweepOptions* o) { o->wait = true; }, "--wait: only for --backend slurm"},
+      {[](SweepOptions* o) { o->sbatch_args.push_back("-p"); }, "--sbatch-arg: only for --backend slurm"},
+  };
+  for (const auto& [change, expect] : cases) {
+    SweepOptions o = good;
+    change(&o);
+    EXPECT_EQ(test::inputError([&] { runSweep(o); }), expect);
+  }
+  EXPECT_FALSE(fs::exists(good.out));
+  EXPECT_NE(test::inputError([&] { sweepStatus(dir); }).find("is not a sweep folder (no trials.csv)"),
+            std::string::npos);
+}
+
+TEST(SweepRunner, LocalRunResumesReportsFailuresAndTidies) {
+  const fs::path dir = test::tempDir();
+  const SweepOptions opt = smokeSweep(dir, 3);
+  const fs::path out = opt.out;
+
+  // Seed 3 fails: the others are done, the failure is listed with its log's last line.
+  Captured c = [&] {
+    const ScopedEnv fail("FAKE_FAIL_SEED", "3");
+    return capture([&] { return runSweep(opt); });
+  }();
+  EXPECT_EQ(c.rc, 1) << c.err;
+  EXPECT_NE(c.err.find("tgnav sweep: 3 trials to run, 2 at a time -> " + out.string()), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("trial smoke__rrtstar-300__s03 failed (exit 3)"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("1 trials failed to run"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("  smoke__rrtstar-300__s03 (exit 3): boom: seed 3"), std::string::npos) << c.err;
+  EXPECT_NE(c.out.find("tgnav sweep: 2 of 3 trials done (2 success); this run: 2 trials in"), std::string::npos)
+      << c.out;
+  EXPECT_EQ(indexIds(out), (std::vector<std::string>{"smoke__rrtstar-300__s01", "smoke__rrtstar-300__s02"}));
+  EXPECT_NE(readText(out / "commands.txt").find("smoke__rrtstar-300__s03 trial --scenario"), std::string::npos);
+
+  SweepStatus s = sweepStatus(out);
+  EXPECT_EQ(s.dir, fs::path(out));
+  EXPECT_EQ(s.trials, 3u);
+  EXPECT_EQ(s.counts.done, 2);
+  EXPECT_EQ(s.counts.absent, 1);
+  EXPECT_FALSE(s.slurm.submitted);
+
+  // A killed trial's staging folders, and a corrupted finished one: tidied, and run again.
+  fs::create_directories(out / "trials" / ".smoke__rrtstar-300__s03.tmp-99999");
+  fs::create_directories(out / "trials" / ".smoke__rrtstar-300__s01.old-99999");
+  test::writeFile(out / "trials" / ".keep", "not a trial's\n");
+  EXPECT_EQ(sweepStatus(out).running, 1u);
+  test::writeFile(out / "trials" / "smoke__rrtstar-300__s02" / "metrics.json", "{\"scene\": ");
+  EXPECT_EQ(sweepStatus(out).counts.corrupt, 1);
+  c = capture([&] { return runSweep(opt); });
+  EXPECT_EQ(c.rc, 0) << c.err;
+  EXPECT_NE(c.err.find("trials/smoke__rrtstar-300__s02 is corrupted (metrics.json does not parse"), std::string::npos)
+      << c.err;
+  EXPECT_NE(c.err.find("resuming: 1 of 3 trials already done"), std::string::npos) << c.err;
+  EXPECT_NE(c.out.find("3 of 3 trials done (3 success); this run: 2 trials in"), std::string::npos) << c.out;
+  EXPECT_TRUE(fs::exists(out / "corrupt" / "smoke__rrtstar-300__s02.1" / "metrics.json"));
+  EXPECT_FALSE(fs::exists(out / "trials" / ".smoke__rrtstar-300__s03.tmp-99999"));
+  EXPECT_FALSE(fs::exists(out / "trials" / ".smoke__rrtstar-300__s01.old-99999"));
+  EXPECT_TRUE(fs::exists(out / "trials" / ".keep"));
+  EXPECT_EQ(indexIds(out).size(), 3u);
+  EXPECT_EQ(readText(out / "logs" / "smoke__rrtstar-300__s01.log").find("=== ", 1), std::string::npos);  // ran once
+  EXPECT_NE(readText(out / "logs" / "smoke__rrtstar-300__s03.log").find("=== ", 1), std::string::npos);
+
+  // Nothing left: said, and nothing runs.
+  c = capture([&] { return runSweep(opt); });
+  EXPECT_EQ(c.rc, 0);
+  EXPECT_EQ(c.out, "tgnav sweep: all 3 trials are done (3 success) -> " + out.string() + "/index.csv\n");
+  EXPECT_EQ(sweepStatus(out).counts.done, 3);
+  EXPECT_EQ(sweepStatus(out).running, 0u);
+
+  // The folder holds this sweep: another one is refused.
+  SweepOptions other = opt;
+  other.sweep = test::writeFile(dir / "other.yaml", readText(opt.sweep) + "set: {camera.width_px: 320}\n").string();
+  EXPECT_NE(test::inputError([&] {
+              runSweep(other);
+            }).find("holds another sweep: its commands.txt differs from " + other.sweep + "'s at line 1"),
+            std::string::npos);
+}
+
+TEST(SweepRunner, SlurmBackendSubmitsAJobArrayAndRefusesWhileItRuns) {
+  const fs::path dir = test::tempDir();
+  SweepOptions opt = smokeSweep(dir, 3);
+  opt.backend = "slurm";
+  opt.jobs = 0;
+  const fs::path out = opt.out;
+  const fs::path bin = dir / "bin";  // stand-ins for sbatch and squeue
+  fs::create_directories(bin);
+  executable(bin / "sbatch",
+             "#!/bin/bash\n"
+             "if [ -n \"${FAKE_SBATCH_FAIL:-}\" ]; then echo 'sbatch: error: invalid partition' >&2; exit 1; fi\n"
+             "echo \"$*\" > \"$(dirname \"$0\")/sbatch.args\"; echo '4242;cluster'\n");
+  executable(bin / "squeue",
+             "#!/bin/bash\n"
+             "if [ -n \"${FAKE_SQUEUE_FAIL:-}\" ]; then echo 'squeue: error: no controller' >&2; exit 1; fi\n"
+             "cat \"$(dirname \"$0\")/queue\" 2>/dev/null; exit 0\n");
+  const ScopedEnv path("PATH", bin.string() + ":" + getenv("PATH"));
+
+  {
+    const ScopedEnv fail("FAKE_SBATCH_FAIL", "1");
+    const std::string refused = test::inputError([&] { capture([&] { return runSweep(opt); }); });
+    EXPECT_NE(refused.find("sbatch failed (exit 1): sbatch: error: invalid partition; nothing was submitted"),
+              std::string::npos)
+        << refused;
+  }
+  EXPECT_FALSE(fs::exists(out / "slurm" / "jobs.txt") || fs::exists(out / "slurm" / "array-1.sh"));
+
+  Captured c = capture([&] { return runSweep(opt); });
+  ASSERT_EQ(c.rc, 0) << c.err;
+  EXPECT_NE(c.out.find("submitted Slurm job array 4242 (3 trials, at most 3 at once)"), std::string::npos) << c.out;
+  EXPECT_EQ(readText(out / "slurm" / "jobs.txt"), "4242 array-1.sh 3\n");
+  const std::string args = readText(bin / "sbatch.args");
+  EXPECT_EQ(args.rfind("--parsable --array=0-2%3 ", 0), 0u) << args;
+  const std::string script = readText(out / "slurm" / "array-1.sh");
+  EXPECT_NE(script.find("#SBATCH --job-name=tgnav-sweep-"), std::string::npos) << script;
+  EXPECT_NE(script.find("  1) id=smoke__rrtstar-300__s02; args=(trial --scenario"), std::string::npos) << script;
+  EXPECT_NE(script.find("--threads 1 --no-figures --force --map-cache"), std::string::npos) << script;
+  EXPECT_NE(script.find(opt.program.string() + " sweep --status --out ."), std::string::npos) << script;
+
+  SweepStatus s = sweepStatus(out);
+  EXPECT_TRUE(s.slurm.submitted);
+  EXPECT_TRUE(s.slurm.error.empty()) << s.slurm.error;
+  EXPECT_TRUE(s.slurm.states.empty());
+
+  test::writeFile(bin / "queue", "4242_0 RUNNING\n4242_1 PENDING\n");
+  s = sweepStatus(out);
+  EXPECT_EQ(s.slurm.states, (std::map<std::string, int>{{"PENDING", 1}, {"RUNNING", 1}}));
+  const std::string busy = test::inputError([&] { runSweep(opt); });
+  EXPECT_NE(busy.find("2 tasks of this sweep are still queued or running in Slurm (job 4242)"), std::string::npos)
+      << busy;
+  EXPECT_FALSE(fs::exists(out / "slurm" / "array-2.sh"));
+  {
+    const ScopedEnv fail("FAKE_SQUEUE_FAIL", "1");
+    s = sweepStatus(out);
+    EXPECT_NE(s.slurm.error.find("squeue failed (exit 1): squeue: error: no controller"), std::string::npos)
+        << s.slurm.error;
+  }
 }
 
 }  // namespace

@@ -7,10 +7,11 @@
 #include <fstream>
 #include <string>
 
-#include "harness/errors.h"
-#include "harness/map_cache.h"
-#include "harness/quiet_stderr.h"
-#include "harness/shell.h"
+#include "harness/base/errors.h"
+#include "harness/base/quiet_stderr.h"
+#include "harness/base/shell.h"
+#include "harness/io/staged_output.h"
+#include "harness/run/map_cache.h"
 #include "planner/feature_map.h"
 
 namespace tgnav::test {
@@ -25,6 +26,14 @@ inline std::filesystem::path tempDir() {
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
+}
+
+// Staging folders (StagedDir) left in `dir`: none once a command has finished or failed.
+inline int stagingLeftIn(const std::filesystem::path& dir) {
+  int n = 0;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) n += harness::isStagingName(e.path().filename());
+  return n;
 }
 
 inline std::filesystem::path writeFile(const std::filesystem::path& path, const std::string& text) {

@@ -1,10 +1,10 @@
 // Trajectory CSV files: what plan writes, fly reads back; malformed files name line, column
 // and value.
-#include "harness/trajectory_csv.h"
+#include "harness/io/trajectory_csv.h"
 
 #include <gtest/gtest.h>
 
-#include "harness/errors.h"
+#include "harness/base/errors.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -21,8 +21,8 @@ std::string errorOf(const std::string& text) {
 }
 
 TEST(TrajectoryCsv, MinimalColumnsAnyOrderWithComments) {
-  const auto file = test::writeFile(test::tempDir() / "t.csv",
-                                    "# comment\nyaw, t, z, y, x\n0.5, 0, 1, 2, 3\n0.6, 1.5, 1, 2, 4\n");
+  const auto file =
+      test::writeFile(test::tempDir() / "t.csv", "# comment\nyaw, t, z, y, x\n0.5, 0, 1, 2, 3\n0.6, 1.5, 1, 2, 4\n");
   const control::SetpointTrajectory t = readTrajectoryCsv(file);
   ASSERT_EQ(t.times().size(), 2u);
   EXPECT_DOUBLE_EQ(t.setpoints()[1].p_WB.x(), 4.0);
@@ -55,8 +55,7 @@ TEST(TrajectoryCsv, RoundTripsAllColumns) {
 
 TEST(TrajectoryCsv, ErrorsNameLineColumnAndValue) {
   EXPECT_NE(errorOf("t,x,y,z,yaw\n0,0,0,1,0\n0,1,0,1,0\n").find(":3: column 't' has value '0'"), std::string::npos);
-  EXPECT_NE(errorOf("t,x,y,z,yaw\n0,0,0,1,0\n1,abc,0,1,0\n").find(":3: column 'x' has value 'abc'"),
-            std::string::npos);
+  EXPECT_NE(errorOf("t,x,y,z,yaw\n0,0,0,1,0\n1,abc,0,1,0\n").find(":3: column 'x' has value 'abc'"), std::string::npos);
   EXPECT_NE(errorOf("t,x,y,z,yaw\n0,0,0,nan,0\n").find("column 'z' has value 'nan'"), std::string::npos);
   EXPECT_NE(errorOf("t,x,y,z,yaw\n0,0,0,1\n").find(":2: row has 4 fields"), std::string::npos);
   EXPECT_NE(errorOf("t,x,y,z,heading\n").find(":1: unknown column 'heading'"), std::string::npos);

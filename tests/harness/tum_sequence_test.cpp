@@ -1,7 +1,7 @@
 // TUM RGB-D sequence folders: what SequenceWriter writes, loadSequence/loadFrame read back
 // (depth to 1/5000 m, timestamps and poses as written); rgb/depth association as TUM's
 // associate.py does it; every kind of bad folder is an InputError naming the file and line.
-#include "harness/tum_sequence.h"
+#include "harness/io/tum_sequence.h"
 
 #include <gtest/gtest.h>
 
@@ -67,7 +67,8 @@ TEST(TumSequence, WriteReadRoundTrip) {
   std::vector<cv::Mat> colours;
   {
     SequenceWriter writer(dir, smallCamera());
-    EXPECT_TRUE(fs::exists(dir.string() + ".partial"));
+    EXPECT_TRUE(fs::exists(writer.staging()));
+    EXPECT_EQ(writer.staging(), harness::stagingPathFor(fs::absolute(dir)));
     EXPECT_FALSE(fs::exists(dir)) << "the sequence appears only when complete";
     for (int i = 0; i < 5; ++i) {
       colours.push_back(colourAt(i));
@@ -77,7 +78,7 @@ TEST(TumSequence, WriteReadRoundTrip) {
     writer.finish();
     EXPECT_EQ(writer.frames(), 5);
   }
-  EXPECT_FALSE(fs::exists(dir.string() + ".partial"));
+  EXPECT_EQ(test::stagingLeftIn(dir.parent_path()), 0);
   for (const char* f : {"rgb.txt", "depth.txt", "groundtruth.txt", "intrinsics.yaml"}) {
     EXPECT_TRUE(fs::is_regular_file(dir / f)) << f;
   }
@@ -143,7 +144,7 @@ TEST(TumSequence, WriterRefusesExistingDirAndCleansUpWhenAbandoned) {
     EXPECT_THROW(writer.add(1.0, cv::Mat(kH, kW + 1, CV_8UC3), depthAt(1), poseAt(1)), std::invalid_argument);
   }
   EXPECT_FALSE(fs::exists(root / "abandoned"));
-  EXPECT_FALSE(fs::exists(root / "abandoned.partial"));
+  EXPECT_EQ(test::stagingLeftIn(root), 0);
 }
 
 TEST(TumSequence, AssociationIsGreedyNearestWithinTolerance) {

@@ -7,11 +7,11 @@
 #include <functional>
 #include <iostream>
 
-#include "harness/camera.h"
-#include "harness/egl_context.h"
-#include "harness/mujoco_sim.h"
-#include "harness/scene_config.h"
-#include "harness/trajectory_csv.h"
+#include "harness/config/scene_config.h"
+#include "harness/io/trajectory_csv.h"
+#include "harness/sim/camera.h"
+#include "harness/sim/egl_context.h"
+#include "harness/sim/mujoco_sim.h"
 #include "test_util.h"
 #include "vo/metrics.h"
 #include "vo/odometry.h"

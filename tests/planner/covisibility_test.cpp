@@ -214,8 +214,8 @@ TEST(Covisibility, SplitMatchesBruteForceVisibilityOnTheVoxelMap) {
     EXPECT_FALSE(s.covisible.empty());
   }
   std::cout << "[ figure   ] wall end: brute-force visibility change at x = " << change << " (" << before
-            << " landmarks seen 0.05 m before), first CR drop in ["
-            << x0 << ", " << x1 << "], " << segs.size() << " segments, " << queries << " queries\n";
+            << " landmarks seen 0.05 m before), first CR drop in [" << x0 << ", " << x1 << "], " << segs.size()
+            << " segments, " << queries << " queries\n";
 }
 
 void expectRejected(const SegmentConfig& config, const std::string& field) {

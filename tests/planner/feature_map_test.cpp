@@ -37,12 +37,12 @@ class FeatureMapTest : public ::testing::Test {
     fillBox(map_.occupancy(), {-0.1, -2.0, 0.0}, {0.1, 2.0, 2.5});
     const Eigen::Vector3d west(-2, 0, 1), east(2, 0, 1);
     map_.setLandmarks({
-        at(-0.1, 0.0, 1.0, west),   // 0: west face, centre
-        at(-0.1, 1.0, 1.0, west),   // 1: west face, left
-        at(0.1, 0.0, 1.0, east),    // 2: east face, centre
-        at(0.1, -1.0, 1.0, east),   // 3: east face
-        at(-0.1, 0.0, 2.0, west),   // 4: west face, high up (28 deg above the horizon from west)
-        at(-1.5, 0.0, 1.0, west),   // 5: floating in free space: no surface, dropped
+        at(-0.1, 0.0, 1.0, west),  // 0: west face, centre
+        at(-0.1, 1.0, 1.0, west),  // 1: west face, left
+        at(0.1, 0.0, 1.0, east),   // 2: east face, centre
+        at(0.1, -1.0, 1.0, east),  // 3: east face
+        at(-0.1, 0.0, 2.0, west),  // 4: west face, high up (28 deg above the horizon from west)
+        at(-1.5, 0.0, 1.0, west),  // 5: floating in free space: no surface, dropped
     });
     dropped_ = map_.embedLandmarks(0.15);
   }

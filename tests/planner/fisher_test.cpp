@@ -104,7 +104,8 @@ TEST(Fisher, LandmarkInformationIsSymmetricPsdRankTwo) {
     const auto& ev = es.eigenvalues();  // ascending
     const double top = ev(5);
     ASSERT_GT(top, 0.0);
-    for (int i = 0; i < 4; ++i) EXPECT_LT(std::abs(ev(i)), 1e-10 * top) << "trial " << trial << " ev " << ev.transpose();
+    for (int i = 0; i < 4; ++i)
+      EXPECT_LT(std::abs(ev(i)), 1e-10 * top) << "trial " << trial << " ev " << ev.transpose();
     EXPECT_GT(ev(4), 1e-6 * top) << "trial " << trial;
     EXPECT_GT(ev(5), 0.0);
   }

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "planner/rrt_star.h"
 #include "tests/planner/synthetic_world.h"
 
 namespace tgnav::planner {
@@ -24,7 +25,7 @@ constexpr double kFlightZ = 1.0;
 // Selection cost.
 
 TEST(SelectionCost, FeatureRichBeatsFeaturePoorUpToTheBreakeven) {
-  const SelectionConfig table1;  // c_p,thr 6, eta_d 0.2, eta_p 1.5
+  const SelectionConfig table1;                                     // c_p,thr 6, eta_d 0.2, eta_p 1.5
   const double poor = 6.0 * std::log(InformationConfig{}.epsilon);  // a blind segment
   const double rich = 30.0;
   const double d_min = 10.0;
@@ -74,7 +75,8 @@ struct Scene {
   Pose4 start, goal;
 };
 
-std::unique_ptr<Scene> buildScene(testing::SyntheticWorld& w, const Eigen::Vector2d& start, const Eigen::Vector2d& goal) {
+std::unique_ptr<Scene> buildScene(testing::SyntheticWorld& w, const Eigen::Vector2d& start,
+                                  const Eigen::Vector2d& goal) {
   for (Landmark& lm : w.landmarks) lm.ref_kf_p_W = lm.p_W + 0.5 * (lm.ref_kf_p_W - lm.p_W);
   const FeatureMap map = w.build();
   auto scene = std::make_unique<Scene>();
@@ -146,8 +148,8 @@ std::unique_ptr<Scene> buildBeamScene(double width) {
   w.solids = {wall, top};
   w.texture(Eigen::AlignedBox3d(Eigen::Vector3d(1.7, 1.8, 0.0), Eigen::Vector3d(width - 1.2, 2.4, 2.0)),
             Eigen::Vector3d(0, -1, 0), 0.1);
-  w.texture(Eigen::AlignedBox3d(Eigen::Vector3d(3.9, 4.9, 0.0), Eigen::Vector3d(width, 5.2, 2.0)), Eigen::Vector3d(0, -1, 0),
-            0.1);
+  w.texture(Eigen::AlignedBox3d(Eigen::Vector3d(3.9, 4.9, 0.0), Eigen::Vector3d(width, 5.2, 2.0)),
+            Eigen::Vector3d(0, -1, 0), 0.1);
   return buildScene(w, {1.8, 1.3}, {2.5, 2.9});
 }
 
@@ -171,7 +173,7 @@ PerceptionPlannerConfig plannerConfig() {
 }
 
 // Index of the class through the blind gap: the shorter reference path.
-int gapClass(const PerceptionPlanReport& r) {
+int gapClass(const Plan& r) {
   if (r.topo.classes.size() != 2u) return -1;
   return r.topo.classes[0].length_m <= r.topo.classes[1].length_m ? 0 : 1;
 }
@@ -179,30 +181,29 @@ int gapClass(const PerceptionPlanReport& r) {
 const double kBlind = 6.0 * std::log(InformationConfig{}.epsilon);  // c_p of a pose that sees nothing
 
 struct Outcome {
-  PerceptionPlanReport report;
+  Plan plan;
   int gap = -1;   // index of the class through the gap
   int over = -1;  // index of the textured class
-  const CandidatePath& gapPath() const { return report.plan.candidates[static_cast<std::size_t>(gap)]; }
-  const CandidatePath& texturedPath() const { return report.plan.candidates[static_cast<std::size_t>(over)]; }
-  bool choseTextured() const { return report.plan.chosen == over; }
+  const CandidatePath& gapPath() const { return plan.candidates[static_cast<std::size_t>(gap)]; }
+  const CandidatePath& texturedPath() const { return plan.candidates[static_cast<std::size_t>(over)]; }
+  bool choseTextured() const { return plan.chosen == over; }
   double ratio() const { return texturedPath().length_m / gapPath().length_m; }
   double referenceRatio() const {
-    return report.topo.classes[static_cast<std::size_t>(over)].length_m /
-           report.topo.classes[static_cast<std::size_t>(gap)].length_m;
+    return plan.topo.classes[static_cast<std::size_t>(over)].length_m /
+           plan.topo.classes[static_cast<std::size_t>(gap)].length_m;
   }
 };
 
 // Solves and checks what every solve must satisfy: two classes, the chosen path is a candidate's,
 // it runs from start to goal, and (proposed) each candidate's cost is eq. 9 of its own figures.
 Outcome solve(const Scene& scene, const PerceptionPlannerConfig& config, PlannerKind kind, std::uint64_t seed) {
-  const PerceptionPlanner planner(*scene.voxels, config);
   Outcome o;
-  o.report = planner.solve(scene.start, scene.goal, kind, seed);
-  const Plan& plan = o.report.plan;
+  o.plan = makePlanner(kind, *scene.voxels, config, RrtStarConfig{})->solve({scene.start, scene.goal, seed});
+  const Plan& plan = o.plan;
   EXPECT_EQ(plan.status, PlanStatus::kSolved);
   EXPECT_EQ(plan.candidates.size(), 2u) << "exactly two homology classes";
   if (plan.status != PlanStatus::kSolved || plan.candidates.size() != 2u) return o;
-  o.gap = gapClass(o.report);
+  o.gap = gapClass(o.plan);
   o.over = 1 - o.gap;
   EXPECT_GE(plan.chosen, 0);
   const CandidatePath& chosen = plan.candidates[static_cast<std::size_t>(plan.chosen)];
@@ -262,9 +263,9 @@ TEST(PerceptionPlanner, SceneATexturedClassTwentyPercentLongerIsChosen) {
   // The perception-agnostic planner takes the short, blind class (yaw along the direction of travel).
   const Outcome ap = solve(scene, config, PlannerKind::kAgnostic, 1);
   ASSERT_GE(ap.gap, 0);
-  EXPECT_EQ(ap.report.plan.chosen, ap.gap);
-  EXPECT_EQ(ap.report.plan.chosen, ap.report.topo.chosen);
-  const auto& path = ap.report.plan.path;
+  EXPECT_EQ(ap.plan.chosen, ap.gap);
+  EXPECT_EQ(ap.plan.chosen, ap.plan.topo.chosen);
+  const auto& path = ap.plan.path;
   for (std::size_t i = 0; i + 1 < path.size(); ++i) {
     const Eigen::Vector3d d = path[i + 1].p_WB - path[i].p_WB;
     if (d.head<2>().norm() > 1e-6) {
@@ -340,14 +341,14 @@ TEST(PerceptionPlanner, SameSeedSamePlanWhateverTheThreadCount) {
   one.threads = 1;
   PerceptionPlannerConfig two = plannerConfig();
   two.threads = 2;
-  const PerceptionPlanReport a = PerceptionPlanner(*scene.voxels, one).solve(scene.start, scene.goal, PlannerKind::kProposed, 42);
-  const PerceptionPlanReport b = PerceptionPlanner(*scene.voxels, two).solve(scene.start, scene.goal, PlannerKind::kProposed, 42);
-  expectSamePlan(a.plan, b.plan);
+  const Plan a = ProposedPlanner(*scene.voxels, one).solve({scene.start, scene.goal, 42});
+  const Plan b = ProposedPlanner(*scene.voxels, two).solve({scene.start, scene.goal, 42});
+  expectSamePlan(a, b);
   // A different seed samples other positions (so the comparison above could fail).
-  const PerceptionPlanReport c = PerceptionPlanner(*scene.voxels, two).solve(scene.start, scene.goal, PlannerKind::kProposed, 43);
-  ASSERT_EQ(c.plan.path.size(), a.plan.path.size());
+  const Plan c = ProposedPlanner(*scene.voxels, two).solve({scene.start, scene.goal, 43});
+  ASSERT_EQ(c.path.size(), a.path.size());
   bool differs = false;
-  for (std::size_t j = 0; j < a.plan.path.size(); ++j) differs = differs || a.plan.path[j].p_WB != c.plan.path[j].p_WB;
+  for (std::size_t j = 0; j < a.path.size(); ++j) differs = differs || a.path[j].p_WB != c.path[j].p_WB;
   EXPECT_TRUE(differs);
 }
 
@@ -356,33 +357,36 @@ TEST(PerceptionPlanner, WithoutLandmarksEveryClassIsBlindAndTheShortestWins) {
   ASSERT_EQ(scene->landmarks, 0);
   const PerceptionPlannerConfig config = plannerConfig();
   const Outcome o = solve(*scene, config, PlannerKind::kProposed, 1);
-  ASSERT_EQ(o.report.plan.status, PlanStatus::kSolved);
-  ASSERT_EQ(o.report.plan.candidates.size(), 2u);
+  ASSERT_EQ(o.plan.status, PlanStatus::kSolved);
+  ASSERT_EQ(o.plan.candidates.size(), 2u);
   int shortest = 0;
   for (int i = 0; i < 2; ++i) {
-    const CandidatePath& c = o.report.plan.candidates[static_cast<std::size_t>(i)];
+    const CandidatePath& c = o.plan.candidates[static_cast<std::size_t>(i)];
     EXPECT_NEAR(c.c_p_min, kBlind, 1e-9);
     EXPECT_NEAR(c.c_p, kBlind, 1e-9);
     for (const ScoredSegment& seg : c.segments) {
       EXPECT_EQ(seg.covisible, 0);
       EXPECT_NEAR(seg.c_p, kBlind, 1e-9);
     }
-    if (c.length_m < o.report.plan.candidates[static_cast<std::size_t>(shortest)].length_m) shortest = i;
+    if (c.length_m < o.plan.candidates[static_cast<std::size_t>(shortest)].length_m) shortest = i;
   }
-  EXPECT_EQ(o.report.plan.chosen, shortest);
-  EXPECT_EQ(o.report.plan.chosen, o.gap);
+  EXPECT_EQ(o.plan.chosen, shortest);
+  EXPECT_EQ(o.plan.chosen, o.gap);
   // Blind segments split down to l_min: none is longer.
-  for (const ClassDetail& d : o.report.details) {
-    for (const PathSegment& seg : d.segments) EXPECT_LE(seg.s_end_m - seg.s_begin_m, config.segments.min_length_m + 1e-12);
+  for (const ClassDetail& d : o.plan.details) {
+    for (const PathSegment& seg : d.segments)
+      EXPECT_LE(seg.s_end_m - seg.s_begin_m, config.segments.min_length_m + 1e-12);
   }
 }
 
 void expectRejected(const PerceptionPlannerConfig& config, const VoxelMap& voxels, const std::string& field) {
-  try {
-    const PerceptionPlanner planner(voxels, config);
-    ADD_FAILURE() << "accepted, expected a complaint about " << field;
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+  for (PlannerKind kind : {PlannerKind::kProposed, PlannerKind::kAgnostic}) {
+    try {
+      const std::unique_ptr<Planner> planner = makePlanner(kind, voxels, config, RrtStarConfig{});
+      ADD_FAILURE() << toString(kind) << " accepted, expected a complaint about " << field;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
   }
 }
 
@@ -391,7 +395,8 @@ TEST(PerceptionPlanner, ConstructorRejectsBadConfigsNamingTheField) {
   w.max_W = {3.0, 3.0, 2.0};
   const FeatureMap map = w.build();
   const VoxelMap voxels(map, w.min_W, w.max_W);
-  EXPECT_NO_THROW(PerceptionPlanner(voxels, PerceptionPlannerConfig{}));
+  EXPECT_NO_THROW(ProposedPlanner(voxels, PerceptionPlannerConfig{}));
+  EXPECT_NO_THROW(AgnosticPlanner(voxels, PerceptionPlannerConfig{}));
   PerceptionPlannerConfig c;
   c.segments.covisibility_ratio = 1.5;
   expectRejected(c, voxels, "covisibility_ratio");

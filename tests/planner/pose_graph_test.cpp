@@ -102,7 +102,8 @@ TEST(LayeredDag, DynamicProgrammeEqualsBruteForceOnRandomDags) {
     ASSERT_EQ(got.nodes.size(), static_cast<std::size_t>(layers)) << "graph " << g;
     for (int j = 0; j < layers; ++j) {
       ASSERT_GE(got.nodes[static_cast<std::size_t>(j)], 0);
-      ASSERT_LT(got.nodes[static_cast<std::size_t>(j)], static_cast<int>(dag.node_cost[static_cast<std::size_t>(j)].size()));
+      ASSERT_LT(got.nodes[static_cast<std::size_t>(j)],
+                static_cast<int>(dag.node_cost[static_cast<std::size_t>(j)].size()));
     }
     // The returned sequence is a path (every step an edge) whose cost is the reported one.
     EXPECT_NEAR(sequenceCost(dag, got.nodes), got.cost, 1e-12) << "graph " << g;
@@ -169,8 +170,8 @@ const Corridor& texturedCorridor(int side) {
 PoseGraphResult search(const Corridor& c, const PoseGraphConfig& config, std::uint64_t seed,
                        double start_yaw = std::nan("")) {
   const VisibilityConfig vis;
-  const std::vector<PathSegment> segments = extractSegments(
-      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments =
+      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
   return searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, config, start_yaw, seed);
 }
 
@@ -182,7 +183,8 @@ void expectFeasible(const Corridor& c, const PoseGraphResult& r, const PoseGraph
   const std::size_t n = r.path.size();
   ASSERT_EQ(r.layer_s.size(), n);
   ASSERT_EQ(r.scores.size(), n);
-  EXPECT_EQ(static_cast<int>(n), static_cast<int>(std::ceil(length / (config.nominal_speed_mps * config.time_step_s) - 1e-9)) + 1);
+  EXPECT_EQ(static_cast<int>(n),
+            static_cast<int>(std::ceil(length / (config.nominal_speed_mps * config.time_step_s) - 1e-9)) + 1);
   EXPECT_LT((r.path.front().p_WB - c.path.front()).norm(), 1e-12);
   EXPECT_LT((r.path.back().p_WB - c.path.back()).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(r.layer_s.front(), 0.0);
@@ -274,7 +276,8 @@ TEST(PoseGraph, WithoutPerceptionThePathIsTheReferenceLine) {
   // With perception, the path leaves the line for a better view (so the check above can fail).
   const PoseGraphResult p = search(c, PoseGraphConfig{}, 1);
   double off = 0.0;
-  for (std::size_t j = 0; j < p.path.size(); ++j) off = std::max(off, (p.path[j].p_WB - pointAt(c.path, p.layer_s[j])).norm());
+  for (std::size_t j = 0; j < p.path.size(); ++j)
+    off = std::max(off, (p.path[j].p_WB - pointAt(c.path, p.layer_s[j])).norm());
   std::cout << "[ figure   ] largest departure from the reference line with perception: " << off << " m\n";
 }
 
@@ -284,18 +287,18 @@ TEST(PoseGraph, ChosenScoresMatchPoseScore) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;
   const InformationConfig info;
-  const std::vector<PathSegment> segments = extractSegments(
-      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments =
+      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
   int checked = 0;
   for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
-    const PoseGraphResult r =
-        searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
+    const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
     ASSERT_TRUE(r.found);
     for (std::size_t j = 0; j < r.path.size(); ++j) {
       const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
       const std::vector<WeightedPoint> points = aggregateByVoxel(c.voxels, seg.covisible);
       const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
-      EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct))) << "start yaw " << start_yaw << " layer " << j;
+      EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
+          << "start yaw " << start_yaw << " layer " << j;
       EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
       EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
       ++checked;
@@ -318,10 +321,12 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   frozen.yaw_rate_limit_rad_s = 1e-6;
   for (double length : {2.9, 2.41, 1.25, 0.81}) {
     const std::vector<Eigen::Vector3d> path{{0.5, 1.5, kZ}, {0.5 + length, 1.5, kZ}};
-    const std::vector<PathSegment> segments = extractSegments(
-        path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
-    const PoseGraphResult a = searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, defaults, std::nan(""), 9);
-    const PoseGraphResult b = searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, frozen, std::nan(""), 9);
+    const std::vector<PathSegment> segments =
+        extractSegments(path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+    const PoseGraphResult a =
+        searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, defaults, std::nan(""), 9);
+    const PoseGraphResult b =
+        searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, frozen, std::nan(""), 9);
     ASSERT_TRUE(a.found);
     ASSERT_EQ(a.nodes, b.nodes);
     const double spacing = a.layer_s[1] - a.layer_s[0];
@@ -336,10 +341,12 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   ASSERT_NO_THROW(fine.validate());
   PoseGraphConfig fine_frozen = fine;
   fine_frozen.yaw_rate_limit_rad_s = 1e-6;
-  const std::vector<PathSegment> segments = extractSegments(
-      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
-  const PoseGraphResult a = searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine, std::nan(""), 9);
-  const PoseGraphResult b = searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine_frozen, std::nan(""), 9);
+  const std::vector<PathSegment> segments =
+      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const PoseGraphResult a =
+      searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine, std::nan(""), 9);
+  const PoseGraphResult b =
+      searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine_frozen, std::nan(""), 9);
   ASSERT_TRUE(a.found);
   std::cout << "[ figure   ] 7 m corridor, 21 yaw samples: edges " << a.edges << " (frozen yaw: " << b.edges << ")\n";
   EXPECT_GT(a.edges, b.edges) << "7 m path, 21 yaw samples: the yaw cannot change between any two layers";

@@ -1,6 +1,7 @@
 // Perception-aware RRT* (paper Sec. VI-A, "R-N"): on a two-route world it trades length for
 // co-visible texture when lambda_p > 0 and takes the short route when lambda_p = 0; plans are
-// collision-free, end at the start and goal, and are reproducible per seed; bad input is refused.
+// collision-free, end at the start and goal, and are reproducible per seed; the homology class it
+// reports is its path's; bad input is refused.
 #include "planner/rrt_star.h"
 
 #include <gtest/gtest.h>
@@ -13,9 +14,11 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "planner/fisher.h"
 #include "planner/perception.h"
+#include "planner/topological_planner.h"
 #include "synthetic_world.h"
 
 namespace tgnav::planner {
@@ -88,7 +91,7 @@ SideTally chooseSides(double lambda_p) {
   double length = 0.0;
   for (std::uint64_t seed = 1; seed <= 10; ++seed) {
     const auto t0 = std::chrono::steady_clock::now();
-    const Plan plan = planner.solve(w.start, w.goal, seed);
+    const Plan plan = planner.solve({w.start, w.goal, seed});
     time += seconds(t0);
     EXPECT_EQ(plan.status, PlanStatus::kSolved) << "seed " << seed;
     if (plan.status != PlanStatus::kSolved) continue;
@@ -117,9 +120,9 @@ TEST(PerceptionRrtStar, SeededRunsRepeatAndMoreSamplesNeverCostMore) {
   RrtStarConfig config;
   config.samples = 400;
   const PerceptionRrtStar planner(w.voxels, config);
-  const Plan a = planner.solve(w.start, w.goal, 7);
-  const Plan b = planner.solve(w.start, w.goal, 7);
-  const Plan c = planner.solve(w.start, w.goal, 8);
+  const Plan a = planner.solve({w.start, w.goal, 7});
+  const Plan b = planner.solve({w.start, w.goal, 7});
+  const Plan c = planner.solve({w.start, w.goal, 8});
   ASSERT_EQ(a.status, PlanStatus::kSolved);
   ASSERT_EQ(b.status, PlanStatus::kSolved);
   ASSERT_EQ(c.status, PlanStatus::kSolved);
@@ -137,7 +140,7 @@ TEST(PerceptionRrtStar, SeededRunsRepeatAndMoreSamplesNeverCostMore) {
   for (int n : {300, 1000, 2000}) {
     config.samples = n;
     const auto t0 = std::chrono::steady_clock::now();
-    const Plan plan = PerceptionRrtStar(w.voxels, config).solve(w.start, w.goal, 3);
+    const Plan plan = PerceptionRrtStar(w.voxels, config).solve({w.start, w.goal, 3});
     const double time = seconds(t0);
     const double cost = plan.status == PlanStatus::kSolved ? plan.candidates[0].cost : previous;
     std::cout << "[ figure   ] R-" << n << " seed 3: " << toString(plan.status) << ", solve " << time << " s, cost "
@@ -145,7 +148,7 @@ TEST(PerceptionRrtStar, SeededRunsRepeatAndMoreSamplesNeverCostMore) {
     EXPECT_LE(cost, previous) << "N = " << n;
     previous = cost;
   }
-  EXPECT_EQ(PerceptionRrtStar(w.voxels, config).solve(w.start, w.goal, 3).status, PlanStatus::kSolved);
+  EXPECT_EQ(PerceptionRrtStar(w.voxels, config).solve({w.start, w.goal, 3}).status, PlanStatus::kSolved);
 }
 
 // Every edge keeps the robot radius, the path runs from the start pose to the goal pose at the
@@ -157,7 +160,7 @@ TEST(PerceptionRrtStar, PathsAreClearEndToEndAndScoredByCovisibleLandmarks) {
   config.samples = 600;
   const PerceptionRrtStar planner(w.voxels, config);
   for (std::uint64_t seed : {11u, 12u, 13u}) {
-    const Plan plan = planner.solve(w.start, w.goal, seed);
+    const Plan plan = planner.solve({w.start, w.goal, seed});
     ASSERT_EQ(plan.status, PlanStatus::kSolved) << "seed " << seed;
     ASSERT_EQ(plan.chosen, 0);
     ASSERT_EQ(plan.candidates.size(), 1u);
@@ -219,6 +222,54 @@ TEST(PerceptionRrtStar, PathsAreClearEndToEndAndScoredByCovisibleLandmarks) {
   }
 }
 
+// RRT* labels its own path: chosen_class is the class that a TopologicalPlanner of our own on the
+// same slice gives the path's H-signature, i.e. the class passing the block on the path's side.
+TEST(PerceptionRrtStar, ChosenClassIsTheSliceClassOfThePath) {
+  const TwoRoutes& w = twoRoutes();
+  RrtStarConfig config;
+  config.samples = 600;
+  TopoPlannerConfig topo_config = config.topo;
+  topo_config.robot_radius_m = config.robot_radius_m;
+  const TopologicalPlanner labeller(
+      w.voxels.slice(kFlightZ - config.slice_half_height_m, kFlightZ + config.slice_half_height_m), topo_config);
+  const TopoPlan slice = labeller.solve(w.start.p_WB.head<2>(), w.goal.p_WB.head<2>());
+  ASSERT_EQ(slice.status, PlanStatus::kSolved);
+  ASSERT_EQ(slice.classes.size(), 2u) << "above or below the block";
+  int sides_seen[2] = {0, 0};  // below (textured), above (short)
+  for (double lambda_p : {0.0, 1.0}) {
+    config.perception_weight = lambda_p;
+    const PerceptionRrtStar planner(w.voxels, config);
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+      const Plan plan = planner.solve({w.start, w.goal, seed});
+      ASSERT_EQ(plan.status, PlanStatus::kSolved) << "lambda_p " << lambda_p << " seed " << seed;
+      ASSERT_EQ(plan.topo.classes.size(), slice.classes.size());
+      for (std::size_t k = 0; k < slice.classes.size(); ++k) {
+        EXPECT_EQ(plan.topo.classes[k].h_signature, slice.classes[k].h_signature) << "class " << k;
+      }
+      EXPECT_EQ(plan.flight_height_m, kFlightZ);
+      std::vector<Eigen::Vector2d> xy;
+      for (const Pose4& p : plan.path) xy.push_back(p.p_WB.head<2>());
+      const std::vector<double> h = labeller.hSignature(xy);
+      EXPECT_EQ(plan.candidates[0].h_signature, h);
+      int label = -1;
+      for (std::size_t k = 0; k < slice.classes.size() && label < 0; ++k) {
+        if (TopologicalPlanner::sameClass(h, slice.classes[k].h_signature)) label = static_cast<int>(k);
+      }
+      ASSERT_GE(label, 0) << "lambda_p " << lambda_p << " seed " << seed;
+      EXPECT_EQ(plan.chosen_class, label) << "lambda_p " << lambda_p << " seed " << seed;
+      std::vector<Pose4> class_path;
+      for (const Eigen::Vector2d& p : slice.classes[static_cast<std::size_t>(label)].path) {
+        class_path.push_back({{p.x(), p.y(), kFlightZ}, 0.0});
+      }
+      const int side = w.side(plan.path);
+      EXPECT_EQ(w.side(class_path), side) << "lambda_p " << lambda_p << " seed " << seed;
+      if (side != 0) ++sides_seen[side > 0 ? 1 : 0];
+    }
+  }
+  EXPECT_GT(sides_seen[0], 0) << "no path below the block: only one class was ever labelled";
+  EXPECT_GT(sides_seen[1], 0) << "no path above the block: only one class was ever labelled";
+}
+
 // Without landmarks every edge pays the full perception penalty: RRT* degenerates to a shortest
 // path with cost (lambda_d + lambda_p f(6 ln eps - c_p,thr)) per metre.
 TEST(PerceptionRrtStar, EmptyLandmarkSetPaysTheFullPenaltyEverywhere) {
@@ -230,7 +281,7 @@ TEST(PerceptionRrtStar, EmptyLandmarkSetPaysTheFullPenaltyEverywhere) {
   RrtStarConfig config;
   config.samples = 500;
   const Plan plan =
-      PerceptionRrtStar(voxels, config).solve({{1.0, 2.5, kFlightZ}, 0.0}, {{7.0, 2.5, kFlightZ}, 1.0}, 5);
+      PerceptionRrtStar(voxels, config).solve({{{1.0, 2.5, kFlightZ}, 0.0}, {{7.0, 2.5, kFlightZ}, 1.0}, 5});
   ASSERT_EQ(plan.status, PlanStatus::kSolved);
   const CandidatePath& c = plan.candidates[0];
   const double blind = 6.0 * std::log(config.information.epsilon);
@@ -256,13 +307,18 @@ TEST(PerceptionRrtStar, RefusesBlockedStartAndGoalAndReportsAnUnreachableGoal) {
   const Pose4 near_block{{3.8, 4.5, kFlightZ}, 0.0};  // 0.2 m from the block: inside the robot radius
   const Pose4 outside{{-1.0, 6.5, kFlightZ}, 0.0};
   const Pose4 above{{1.0, 6.5, 3.0}, 0.0};  // flight height over the map's box
-  EXPECT_EQ(planner.solve(in_block, w.goal, 1).status, PlanStatus::kInvalidStart);
-  EXPECT_EQ(planner.solve(near_block, w.goal, 1).status, PlanStatus::kInvalidStart);
-  EXPECT_EQ(planner.solve(outside, w.goal, 1).status, PlanStatus::kInvalidStart);
-  EXPECT_EQ(planner.solve(above, w.goal, 1).status, PlanStatus::kInvalidStart);
-  EXPECT_EQ(planner.solve(w.start, in_block, 1).status, PlanStatus::kInvalidGoal);
-  EXPECT_EQ(planner.solve(w.start, near_block, 1).status, PlanStatus::kInvalidGoal);
-  EXPECT_EQ(planner.solve(w.start, outside, 1).status, PlanStatus::kInvalidGoal);
+  EXPECT_EQ(planner.solve({in_block, w.goal, 1}).status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(planner.solve({near_block, w.goal, 1}).status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(planner.solve({outside, w.goal, 1}).status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(planner.solve({above, w.goal, 1}).status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(planner.solve({w.start, in_block, 1}).status, PlanStatus::kInvalidGoal);
+  EXPECT_EQ(planner.solve({w.start, near_block, 1}).status, PlanStatus::kInvalidGoal);
+  EXPECT_EQ(planner.solve({w.start, outside, 1}).status, PlanStatus::kInvalidGoal);
+  // The slice's classes are listed whatever RRT* says, as the topological planner finds them.
+  const Plan refused = planner.solve({in_block, w.goal, 1});
+  EXPECT_EQ(refused.topo.status, PlanStatus::kInvalidStart);
+  EXPECT_EQ(refused.chosen_class, -1);
+  EXPECT_EQ(refused.flight_height_m, kFlightZ);
 
   // A free pocket walled in on all four sides: the goal is valid but out of reach.
   testing::SyntheticWorld world;
@@ -274,11 +330,12 @@ TEST(PerceptionRrtStar, RefusesBlockedStartAndGoalAndReportsAnUnreachableGoal) {
   const FeatureMap map = world.build();
   const VoxelMap voxels(map, world.min_W, world.max_W);
   const Plan plan =
-      PerceptionRrtStar(voxels, config).solve({{1.0, 2.5, kFlightZ}, 0.0}, {{6.0, 2.5, kFlightZ}, 0.0}, 1);
+      PerceptionRrtStar(voxels, config).solve({{{1.0, 2.5, kFlightZ}, 0.0}, {{6.0, 2.5, kFlightZ}, 0.0}, 1});
   EXPECT_EQ(plan.status, PlanStatus::kNoPath);
   EXPECT_TRUE(plan.candidates.empty());
   EXPECT_TRUE(plan.path.empty());
   EXPECT_EQ(plan.chosen, -1);
+  EXPECT_EQ(plan.chosen_class, -1);
 }
 
 TEST(PerceptionRrtStar, ValidateNamesTheBadField) {
@@ -306,6 +363,9 @@ TEST(PerceptionRrtStar, ValidateNamesTheBadField) {
   EXPECT_NE(error([](RrtStarConfig& c) { c.visibility.max_range_m = 0.1; }).find("max_range_m"), std::string::npos);
   EXPECT_NE(error([](RrtStarConfig& c) { c.information.bearing_noise_rad = 0.0; }).find("bearing_noise_rad"),
             std::string::npos);
+  EXPECT_NE(error([](RrtStarConfig& c) { c.slice_half_height_m = -0.1; }).find("slice_half_height_m"),
+            std::string::npos);
+  EXPECT_NE(error([](RrtStarConfig& c) { c.topo.max_classes = 0; }).find("max_classes"), std::string::npos);
   RrtStarConfig bad;
   bad.samples = 0;
   EXPECT_THROW(PerceptionRrtStar(twoRoutes().voxels, bad), std::invalid_argument);

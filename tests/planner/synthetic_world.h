@@ -47,8 +47,8 @@ struct SyntheticWorld {
           const Eigen::Vector3d p(x, y, z);
           bool solid = false;
           for (const auto& box : solids) solid = solid || box.contains(p);
-          tree.updateNode(octomap::point3d(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)),
-                          solid, /*lazy_eval=*/true);
+          tree.updateNode(octomap::point3d(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)), solid,
+                          /*lazy_eval=*/true);
         }
       }
     }

@@ -112,9 +112,9 @@ TEST(Gvd, CellsAreEquidistantToTwoObstaclesWithinOneCell) {
 
 TEST(TopoGraph, PlusShapedCorridorsHaveOneJunctionAndFourEnds) {
   OccupancyGrid2D grid = room(10.0, 10.0);
-  block(grid, -1, -1, 11, 11);                       // all solid
-  block(grid, 0.5, 4.5, 9.5, 5.5, /*occ=*/false);    // horizontal corridor
-  block(grid, 4.5, 0.5, 5.5, 9.5, /*occ=*/false);    // vertical corridor
+  block(grid, -1, -1, 11, 11);                     // all solid
+  block(grid, 0.5, 4.5, 9.5, 5.5, /*occ=*/false);  // horizontal corridor
+  block(grid, 4.5, 0.5, 5.5, 9.5, /*occ=*/false);  // vertical corridor
   const DistanceField field(grid);
   GvdConfig config;
   config.robot_radius_m = 0.2;
@@ -141,9 +141,9 @@ TEST(TopologicalPlanner, StartAndGoalAttachAndBadEndsAreReported) {
   EXPECT_EQ(plan.classes.size(), 2u);
   EXPECT_TRUE((plan.classes[0].path.front() - Eigen::Vector2d(0.5, 0.5)).norm() < 1e-9);
   EXPECT_TRUE((plan.classes[0].path.back() - Eigen::Vector2d(7.5, 5.5)).norm() < 1e-9);
-  EXPECT_EQ(planner.solve({4.0, 3.0}, {7.5, 5.5}).status, PlanStatus::kInvalidStart);   // in the pillar
-  EXPECT_EQ(planner.solve({0.5, 0.5}, {9.0, 5.5}).status, PlanStatus::kInvalidGoal);    // off the map
-  EXPECT_EQ(planner.solve({0.5, 0.5}, {4.0, 3.7}).status, PlanStatus::kInvalidGoal);    // too close
+  EXPECT_EQ(planner.solve({4.0, 3.0}, {7.5, 5.5}).status, PlanStatus::kInvalidStart);  // in the pillar
+  EXPECT_EQ(planner.solve({0.5, 0.5}, {9.0, 5.5}).status, PlanStatus::kInvalidGoal);   // off the map
+  EXPECT_EQ(planner.solve({0.5, 0.5}, {4.0, 3.7}).status, PlanStatus::kInvalidGoal);   // too close
   // A wall across the room: nothing connects.
   OccupancyGrid2D split = room(8.0, 6.0);
   block(split, 3.9, -1.0, 4.1, 7.0);
@@ -209,7 +209,7 @@ TEST(TopologicalPlanner, ShortestClassIsNearOptimalOnRandomMaps) {
       const double x = pos(rng), y = pos(rng);
       block(grid, x, y, x + size(rng), y + size(rng));
     }
-    block(grid, 0.0, 0.0, 1.5, 1.5, false);   // keep start and goal free
+    block(grid, 0.0, 0.0, 1.5, 1.5, false);  // keep start and goal free
     block(grid, 8.5, 8.5, 10.0, 10.0, false);
     const TopologicalPlanner planner(grid, TopoPlannerConfig{});
     const Eigen::Vector2d s(0.7, 0.7), t(9.3, 9.3);
@@ -226,7 +226,8 @@ TEST(TopologicalPlanner, ShortestClassIsNearOptimalOnRandomMaps) {
     EXPECT_LE(ours, 1.05 * ref) << "trial " << trial;
     ++compared;
   }
-  std::cout << "[ figure   ] shortest class / 8-connected optimum: worst " << worst << " over " << compared << " maps\n";
+  std::cout << "[ figure   ] shortest class / 8-connected optimum: worst " << worst << " over " << compared
+            << " maps\n";
   EXPECT_EQ(compared, 20);
 }
 

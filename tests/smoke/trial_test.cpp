@@ -11,7 +11,7 @@
 #include <sstream>
 
 #include "../harness/test_util.h"
-#include "harness/scenario.h"
+#include "harness/config/scenario.h"
 #include "vo/tum.h"
 
 namespace tgnav {
@@ -56,9 +56,9 @@ void expectTrialFolder(const std::filesystem::path& dir) {
   }
   EXPECT_FALSE(std::filesystem::exists(dir / "INCOMPLETE"));
   const nlohmann::json m = readJson(dir / "metrics.json");
-  for (const char* key : {"planner", "seed", "status", "path_length_m", "planned_length_m", "goal_error_m",
-                          "ate_rmse_m", "vo_frames", "vo_lost_at_s", "plan_time_s", "sim_time_s", "wall_time_s",
-                          "real_time_factor", "peak_rss_mb"}) {
+  for (const char* key :
+       {"planner", "seed", "status", "path_length_m", "planned_length_m", "goal_error_m", "ate_rmse_m", "vo_frames",
+        "vo_lost_at_s", "plan_time_s", "sim_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb"}) {
     EXPECT_TRUE(m.contains(key)) << key;
   }
   ASSERT_TRUE(m.contains("timing"));
@@ -99,8 +99,8 @@ TEST_P(SmokeFlight, ReachesTheGoalWithVoTracking) {
   expectTrialFolder(out);
   const nlohmann::json m = readJson(out / "metrics.json");
   std::cout << "[ figure   ] smoke " << planner << ": " << m["status"] << ", flown " << m["path_length_m"]
-            << " m, goal error " << m["goal_error_m"] << " m, ATE " << m["ate_rmse_m"] << " m over "
-            << m["vo_frames"] << " frames, real-time factor " << m["real_time_factor"] << "\n";
+            << " m, goal error " << m["goal_error_m"] << " m, ATE " << m["ate_rmse_m"] << " m over " << m["vo_frames"]
+            << " frames, real-time factor " << m["real_time_factor"] << "\n";
   EXPECT_EQ(m["status"], "success") << m["detail"];
   EXPECT_EQ(m["planner"], planner);
   EXPECT_EQ(m["camera"]["width_px"], 320);
@@ -182,8 +182,7 @@ TEST(SmokeTrialCli, RefusesResultsFolderUnlessForced) {
   const CmdResult again = shell(trialCommand("--planner agnostic" + kSmall + " --out " + out.string()));
   EXPECT_EQ(again.rc, 2);
   EXPECT_EQ(lines(again.output), 1) << again.output;
-  EXPECT_NE(again.output.find("already holds the results of a trial; use --force"), std::string::npos)
-      << again.output;
+  EXPECT_NE(again.output.find("already holds the results of a trial; use --force"), std::string::npos) << again.output;
   EXPECT_EQ(readText(out / "metrics.json"), before);
   const CmdResult forced =
       shell(trialCommand("--planner agnostic --seed 2" + kSmall + " --force --out " + out.string()));
@@ -218,8 +217,8 @@ TEST(SmokeTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
   EXPECT_EQ(unwritable.rc, 2) << unwritable.output;
   EXPECT_NE(unwritable.output.find("--out: cannot"), std::string::npos) << unwritable.output;
   // A scenario that does not exist.
-  const CmdResult missing = shell(std::string(TGNAV_BIN) + " trial --scenario " + (dir / "none.yaml").string() +
-                                  " --out " + out.string());
+  const CmdResult missing =
+      shell(std::string(TGNAV_BIN) + " trial --scenario " + (dir / "none.yaml").string() + " --out " + out.string());
   EXPECT_EQ(missing.rc, 2) << missing.output;
   EXPECT_NE(missing.output.find("none.yaml"), std::string::npos) << missing.output;
   EXPECT_TRUE(std::filesystem::is_empty(dir));
@@ -228,8 +227,8 @@ TEST(SmokeTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
   const auto out = tempDir() / "trial";
   // A long final hold keeps the vehicle flying when the signal comes.
-  const std::string cmd = trialCommand("--planner agnostic" + kSmall + " --set trial.flight.hold_s=120 --out " +
-                                       out.string());
+  const std::string cmd =
+      trialCommand("--planner agnostic" + kSmall + " --set trial.flight.hold_s=120 --out " + out.string());
   const CmdResult run = shell("(" + cmd + " & pid=$!; sleep 12; kill -INT $pid; wait $pid; echo rc=$?)");
   EXPECT_NE(run.output.find("rc=130"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("INCOMPLETE"), std::string::npos) << run.output;

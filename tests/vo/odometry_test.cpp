@@ -1,9 +1,11 @@
 // RgbdOdometry on synthetic RGB-D frames: a textured plane 2 m ahead seen by a camera sliding
-// sideways (the image is a shifted crop of a larger texture, depth constant), and bad frames.
+// sideways (the image is a shifted crop of a larger texture, depth constant), bad frames, and
+// decideStatus's thresholds.
 #include "vo/odometry.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -131,6 +133,66 @@ TEST(Odometry, BadFramesAndConfigsAreRefused) {
   c.ratio_test = 1.5;
   EXPECT_NE(message(c).find("ratio_test"), std::string::npos);
   EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
+}
+
+// decideStatus: lost below min_inliers, weak from there to below weak_inliers, ok from
+// weak_inliers on; each threshold's boundary belongs to the better status.
+TEST(DecideStatus, ThresholdsAndTheirBoundaries) {
+  const OdometryConfig defaults;  // min_inliers 30 (ORB-SLAM2's), weak_inliers 60
+  ASSERT_EQ(defaults.min_inliers, 30);
+  ASSERT_EQ(defaults.weak_inliers, 60);
+  EXPECT_EQ(decideStatus(0, defaults), TrackingStatus::kLost);
+  EXPECT_EQ(decideStatus(29, defaults), TrackingStatus::kLost);
+  EXPECT_EQ(decideStatus(30, defaults), TrackingStatus::kWeak);
+  EXPECT_EQ(decideStatus(59, defaults), TrackingStatus::kWeak);
+  EXPECT_EQ(decideStatus(60, defaults), TrackingStatus::kOk);
+  EXPECT_EQ(decideStatus(1000, defaults), TrackingStatus::kOk);
+
+  OdometryConfig config;
+  config.min_inliers = 4;  // the least PnP allows
+  config.weak_inliers = 5;
+  config.validate();
+  EXPECT_EQ(decideStatus(3, config), TrackingStatus::kLost);
+  EXPECT_EQ(decideStatus(4, config), TrackingStatus::kWeak);
+  EXPECT_EQ(decideStatus(5, config), TrackingStatus::kOk);
+}
+
+TEST(DecideStatus, NoWeakBandWhenBothThresholdsAgree) {
+  OdometryConfig config;
+  config.min_inliers = 40;
+  config.weak_inliers = 40;
+  config.validate();
+  EXPECT_EQ(decideStatus(39, config), TrackingStatus::kLost);
+  EXPECT_EQ(decideStatus(40, config), TrackingStatus::kOk);
+}
+
+// Every tracked frame's status is decideStatus of its inliers. The weak threshold only labels
+// frames (tracking goes on the same), so one at the median of a first run's inliers gives the
+// same run with both weak and ok frames.
+TEST(DecideStatus, TrackedFramesTakeTheStatusOfTheirInliers) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  auto run = [&](const OdometryConfig& config) {
+    RgbdOdometry vo(camera(), config);
+    for (int i = 0; i < 40; ++i) vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth());
+    return vo.history();
+  };
+  const std::vector<FrameResult> first = run(OdometryConfig{});
+  std::vector<int> inliers;
+  for (std::size_t i = 1; i < first.size(); ++i) inliers.push_back(first[i].inliers);
+  std::nth_element(inliers.begin(), inliers.begin() + inliers.size() / 2, inliers.end());
+  OdometryConfig config;
+  config.weak_inliers = inliers[inliers.size() / 2];
+  const std::vector<FrameResult> second = run(config);
+  ASSERT_EQ(second.size(), first.size());
+  int weak = 0, ok = 0;
+  for (std::size_t i = 1; i < second.size(); ++i) {  // frame 0 initialises
+    EXPECT_EQ(second[i].inliers, first[i].inliers) << "frame " << i;
+    EXPECT_EQ(second[i].status, decideStatus(second[i].inliers, config)) << "frame " << i;
+    weak += second[i].status == TrackingStatus::kWeak;
+    ok += second[i].status == TrackingStatus::kOk;
+  }
+  EXPECT_GT(weak, 0);
+  EXPECT_GT(ok, 0);
 }
 
 }  // namespace

@@ -1,0 +1,28 @@
+#pragma once
+// Subcommands of the `tgnav` program. Each registers itself on the app; its callback throws
+// InputError for bad input (exit 2) and anything else for internal failures (exit 1).
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+#include "harness/config/values.h"
+
+namespace tgnav::cli {
+
+using harness::parseNumbers;
+
+void addDefaultsCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
+void addSweepCommand(CLI::App& app);
+void addFlyCommand(CLI::App& app);
+void addMapCommand(CLI::App& app);
+void addPlanCommand(CLI::App& app);
+void addTrialCommand(CLI::App& app);
+void addVoCommand(CLI::App& app);
+
+// An error message on one line: trailing newlines dropped, inner ones become "; " (library and
+// tool messages may span several).
+std::string oneLine(std::string text);
+
+}  // namespace tgnav::cli

@@ -1,0 +1,52 @@
+// tgnav: headless closed-loop harness for topology-guided perception-aware MAV navigation.
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+
+#include "harness/base/errors.h"
+#include "harness/cli/cli.h"
+
+namespace tgnav::cli {
+
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) {
+    text.replace(i, 1, "; ");
+  }
+  return text;
+}
+
+}  // namespace tgnav::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
+  app.require_subcommand(1);
+  app.failure_message([](const CLI::App*, const CLI::Error& e) {
+    return "tgnav: error: " + std::string(e.what()) + " (see --help)\n";
+  });
+  tgnav::cli::addRenderCommand(app);
+  tgnav::cli::addFlyCommand(app);
+  tgnav::cli::addMapCommand(app);
+  tgnav::cli::addPlanCommand(app);
+  tgnav::cli::addTrialCommand(app);
+  tgnav::cli::addSweepCommand(app);
+  tgnav::cli::addReportCommand(app);
+  tgnav::cli::addVoCommand(app);
+  tgnav::cli::addDefaultsCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {  // a command's own exit code (e.g. 130: interrupted)
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  } catch (const tgnav::InputError& e) {
+    std::fprintf(stderr, "tgnav: error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tgnav: internal error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,30 @@
+#include "harness/config/camera_config.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace tgnav::harness {
+
+namespace {
+template <typename T>
+void require(bool ok, const char* field, T value, const char* rule) {
+  if (!ok) {
+    throw std::invalid_argument(std::string(field) + " = " + std::to_string(value) + ": " + rule);
+  }
+}
+}  // namespace
+
+void CameraConfig::validate() const {
+  if (name.empty()) throw std::invalid_argument("name: must not be empty");
+  require(width_px >= 16 && width_px <= 4096, "width_px", width_px, "must be in [16, 4096]");
+  require(height_px >= 16 && height_px <= 4096, "height_px", height_px, "must be in [16, 4096]");
+  require(near_clip_m > 0.0, "near_clip_m", near_clip_m, "must be > 0");
+  require(far_clip_m > near_clip_m, "far_clip_m", far_clip_m, "must be > near_clip_m");
+  require(min_depth_m >= near_clip_m, "min_depth_m", min_depth_m, "must be >= near_clip_m");
+  require(max_depth_m > min_depth_m && max_depth_m <= far_clip_m, "max_depth_m", max_depth_m,
+          "must be in (min_depth_m, far_clip_m]");
+  require(rgb_noise_sigma >= 0.0, "rgb_noise_sigma", rgb_noise_sigma, "must be >= 0");
+  require(depth_noise_sigma_per_m2 >= 0.0, "depth_noise_sigma_per_m2", depth_noise_sigma_per_m2, "must be >= 0");
+}
+
+}  // namespace tgnav::harness

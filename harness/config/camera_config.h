@@ -1,0 +1,37 @@
+#pragma once
+// Settings of the onboard RGB-D camera (configs/camera.yaml): what the renderer draws and the
+// sensor noise added to it. The renderer itself is harness/sim/camera.h.
+#include <string>
+
+namespace tgnav::harness {
+
+struct CameraConfig {
+  std::string name = "front";  // MJCF camera name
+  int width_px = 640;
+  int height_px = 480;
+  double near_clip_m = 0.05;  // OpenGL clipping planes
+  double far_clip_m = 40.0;
+  double min_depth_m = 0.1;  // depth outside [min, max] is reported invalid (0)
+  double max_depth_m = 10.0;
+  double rgb_noise_sigma = 0.0;           // Gaussian pixel noise, 8-bit intensity units
+  double depth_noise_sigma_per_m2 = 0.0;  // depth noise sigma = k z^2 (structured light)
+
+  // The keys of configs/camera.yaml (harness/config/yaml_util.h).
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("name", name);
+    a("width_px", width_px);
+    a("height_px", height_px);
+    a("near_clip_m", near_clip_m);
+    a("far_clip_m", far_clip_m);
+    a("min_depth_m", min_depth_m);
+    a("max_depth_m", max_depth_m);
+    a("rgb_noise_sigma", rgb_noise_sigma);
+    a("depth_noise_sigma_per_m2", depth_noise_sigma_per_m2);
+  }
+
+  // Throws std::invalid_argument naming the field and value.
+  void validate() const;
+};
+
+}  // namespace tgnav::harness

@@ -1,0 +1,48 @@
+#pragma once
+// configs/planner.yaml <-> the planners' Config structs (strict keys; defaults are Table I).
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "harness/config/yaml_util.h"
+#include "planner/perception_planner.h"
+#include "planner/rrt_star.h"
+#include "planner/trajectory_generator.h"
+
+namespace tgnav::harness {
+
+struct PlannerSettings {
+  planner::PerceptionPlannerConfig perception;  // proposed and agnostic
+  planner::RrtStarConfig rrt_star;              // its robot radius, visibility, information and
+                                                // labelling classes follow `perception`'s (one
+                                                // robot, one sensor, one set of classes)
+  planner::TrajectoryConfig trajectory;         // its robot radius is perception's too
+
+  // The dotted keys of the fields that follow perception's: they have no keys of their own in
+  // planner.yaml, and shareFromPerception() sets them.
+  static const std::vector<std::string>& sharedKeys();
+
+  // The keys of planner.yaml (a scenario's `planner:` section): perception's at the top level,
+  // then `rrt_star:` and `trajectory:`, less sharedKeys(); after each visit the shared fields are
+  // perception's again.
+  template <typename Archive>
+  void visit(Archive& a) {
+    SkipKeys<Archive> s(a, sharedKeys());
+    perception.visit(s);
+    s("rrt_star", rrt_star);
+    s("trajectory", trajectory);
+    shareFromPerception();
+  }
+  // Copies perception's robot radius, visibility, information, slice and topology settings into
+  // the fields named by sharedKeys().
+  void shareFromPerception();
+
+  void validate() const;  // std::invalid_argument naming the key
+};
+
+// A planner.yaml read over `base`, then validated (InputError naming the file).
+inline PlannerSettings loadPlannerSettings(const std::filesystem::path& yaml, PlannerSettings base = {}) {
+  return loadConfigFile(yaml, std::move(base));
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,196 @@
+#include "harness/config/scenario.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "harness/base/errors.h"
+#include "harness/config/config_io.h"
+
+namespace tgnav::harness {
+
+namespace fs = std::filesystem;
+
+namespace {
+// The top-level key of a section's file: "camera" -> "camera_config".
+std::string fileKey(const std::string& section) { return section + "_config"; }
+
+// The keys of the sections (Scenario::visitSections), in order.
+std::vector<std::string> sectionKeys() {
+  Scenario s;
+  KeyLister keys;
+  s.visitSections(keys);
+  return keys.keys();
+}
+
+fs::path existingFile(const YamlDoc& doc, const std::string& key, const fs::path& base) {
+  const std::string text = doc.string(doc.root(), key, "");
+  const fs::path p = fs::absolute(base / text).lexically_normal();
+  if (!fs::is_regular_file(p)) {
+    doc.failKey(doc.root()[key], key, "key '" + key + "' has value '" + text + "': file " + p.string() + " not found");
+  }
+  return p;
+}
+
+// Paths in a scenario file are relative to it; on the command line, to the current directory.
+fs::path relativeFile(const YamlDoc& doc, const std::string& key) {
+  return existingFile(doc, key, doc.isOverrides() ? fs::path() : doc.file().parent_path());
+}
+
+std::uint64_t readSeed(const YamlDoc& doc) {
+  const YAML::Node& root = doc.root();
+  const double seed = doc.number(root, "seed", "");
+  if (seed < 0 || seed != std::floor(seed) || seed > 9.0e15) {
+    doc.failKey(root["seed"], "seed", "key 'seed' has value '" + root["seed"].Scalar() + "', expected an integer >= 0");
+  }
+  return static_cast<std::uint64_t>(seed);
+}
+
+void readPoseOverride(const YamlDoc& doc, const std::string& key, const SceneConfig& scene, planner::Pose4* pose) {
+  if (!doc.root()[key]) return;
+  const std::vector<double> v = doc.numbers(doc.root(), key, 4, "");
+  const Eigen::Vector3d p(v[0], v[1], v[2]);
+  if ((p.array() < scene.bounds_min_m.array()).any() || (p.array() > scene.bounds_max_m.array()).any()) {
+    doc.failKey(doc.root()[key], key, "key '" + key + "' lies outside the bounds of scene " + scene.source.string());
+  }
+  pose->p_WB = p;
+  pose->yaw_rad = v[3];
+}
+
+// The document that sets top-level `key`: the overrides when they do, else the scenario file.
+const YamlDoc& sourceOf(const YamlDoc& doc, const YamlDoc* overrides, const char* key) {
+  return overrides && overrides->root()[key] ? *overrides : doc;
+}
+
+bool isWithin(const std::string& prefix, const std::string& key) {
+  return key == prefix ||
+         (key.size() > prefix.size() && key.compare(0, prefix.size(), prefix) == 0 && key[prefix.size()] == '.');
+}
+
+// The --set assignment that gave the field a validate() message ("field = value: rule") is
+// about: one setting `section.field` or a mapping holding it, else the only one under `section`
+// that sets a key of that name (nested configs name their fields without the nesting).
+std::string offendingAssignment(const YamlDoc& overrides, const std::string& section, const std::string& message) {
+  const std::string field = message.substr(0, std::min(message.find(" = "), message.find(':')));
+  const std::string full = joinKey(section, field);
+  const std::string leaf = field.substr(field.rfind('.') == std::string::npos ? 0 : field.rfind('.') + 1);
+  std::string only;
+  int same_name = 0;
+  for (const std::string& key : overrides.assignedKeys()) {
+    if (isWithin(key, full)) return overrides.assignmentFor(key);
+    const std::size_t dot = key.rfind('.');
+    if (isWithin(section, key) && key.substr(dot == std::string::npos ? 0 : dot + 1) == leaf) {
+      ++same_name;
+      only = overrides.assignmentFor(key);
+    }
+  }
+  return same_name == 1 ? only : std::string();
+}
+
+// One section through its layers: its file, its inline section, the overrides.
+template <typename Config>
+void readSection(const YamlDoc& doc, const YamlDoc* overrides, const std::string& key, Config* c) {
+  const YAML::Node& root = doc.root();
+  const std::string file_key = fileKey(key);
+  if (root[file_key]) *c = loadConfigFile(relativeFile(doc, file_key), Config{});
+  if (root[key]) readConfig(YamlArchive(doc, root[key], key), c);
+  const bool overridden = overrides && overrides->root()[key];
+  if (overridden) readConfig(YamlArchive(*overrides, overrides->root()[key], key), c);
+  if (!root[key] && !overridden) return;
+  try {
+    c->validate();
+  } catch (const std::invalid_argument& e) {
+    std::string where = doc.file().string();
+    if (overridden) {
+      const std::string assignment = offendingAssignment(*overrides, key, e.what());
+      where = assignment.empty() ? where + " (with --set overrides)" : "--set " + assignment;
+    }
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+// An archive over Scenario::visitSections that reads each section through its layers.
+class SectionReader {
+ public:
+  SectionReader(const YamlDoc& doc, const YamlDoc* overrides) : doc_(doc), overrides_(overrides) {}
+  template <typename Config>
+  SectionReader& operator()(const std::string& key, Config& config) {
+    readSection(doc_, overrides_, key, &config);
+    return *this;
+  }
+
+ private:
+  const YamlDoc& doc_;
+  const YamlDoc* overrides_;
+};
+
+YAML::Node poseYaml(const planner::Pose4& pose) {
+  const double v[4] = {pose.p_WB.x(), pose.p_WB.y(), pose.p_WB.z(), pose.yaw_rad};
+  return exactSequence(v, 4);
+}
+}  // namespace
+
+Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
+  const YamlDoc doc = YamlDoc::load(yaml);
+  std::vector<std::string> keys = {"scene", "seed", "start", "goal"};
+  std::vector<std::string> override_keys = keys;
+  for (const std::string& section : sectionKeys()) {
+    keys.insert(keys.end(), {fileKey(section), section});
+    override_keys.push_back(section);
+  }
+  doc.requireKeys(doc.root(), keys, "");
+  if (overrides) {
+    for (const std::string& section : sectionKeys()) {
+      const std::string file_key = fileKey(section);
+      if (overrides->root()[file_key]) {
+        overrides->failKey(overrides->root()[file_key], file_key,
+                           "key '" + file_key + "' names a file and cannot be set with --set; " + "set the keys of '" +
+                               section + "' instead (--set " + section + ".KEY=VALUE)");
+      }
+    }
+    overrides->requireKeys(overrides->root(), override_keys, "");
+  }
+
+  Scenario s;
+  s.source = yaml;
+  s.scene = loadSceneConfig(relativeFile(sourceOf(doc, overrides, "scene"), "scene"));
+  s.seed = readSeed(sourceOf(doc, overrides, "seed"));
+  readPoseOverride(sourceOf(doc, overrides, "start"), "start", s.scene, &s.scene.start);
+  readPoseOverride(sourceOf(doc, overrides, "goal"), "goal", s.scene, &s.scene.goal);
+
+  SectionReader sections(doc, overrides);
+  s.visitSections(sections);
+  return s;
+}
+
+std::string resolvedScenarioYaml(const Scenario& s) {
+  YAML::Node root(YAML::NodeType::Map);
+  root["scene"] = fs::absolute(s.scene.source).lexically_normal().string();
+  root["seed"] = std::to_string(s.seed);
+  root["start"] = poseYaml(s.scene.start);
+  root["goal"] = poseYaml(s.scene.goal);
+  Scenario sections = s;  // visitSections() is not const
+  YamlArchive writer = YamlArchive::writer(root);
+  sections.visitSections(writer);
+  YAML::Emitter out;
+  out << root;
+  return std::string(
+             "# A resolved scenario (harness/scenario.h): every setting in force after the defaults, the\n"
+             "# *_config files, the scenario's sections and the --set overrides were layered. It loads\n"
+             "# back as a scenario and reproduces the run.\n") +
+         out.c_str() + "\n";
+}
+
+std::string defaultSectionsYaml() {
+  YAML::Node root(YAML::NodeType::Map);
+  Scenario defaults;
+  YamlArchive writer = YamlArchive::writer(root);
+  defaults.visitSections(writer);
+  YAML::Emitter out;
+  out << root;
+  return std::string(
+             "# The built-in defaults of every section of a scenario (harness/config/scenario.h), every key\n"
+             "# with its value, in the form of a resolved config.yaml's sections.\n") +
+         out.c_str() + "\n";
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,123 @@
+#include "harness/experiments/sweep_runner.h"
+
+#include <cstdio>
+#include <map>
+#include <stdexcept>
+
+#include "harness/base/errors.h"
+#include "harness/config/scenario.h"
+#include "harness/config/yaml_util.h"
+#include "harness/experiments/sweep_local.h"
+#include "harness/io/staged_output.h"
+#include "harness/run/map_cache.h"
+
+namespace tgnav::harness {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The options on their own, before anything is read or written.
+void checkOptions(const SweepOptions& opt) {
+  if (opt.out.empty()) throw InputError("--out: required");
+  if (opt.sweep.empty()) throw InputError("--sweep: required (or --status)");
+  if (opt.backend != "local" && opt.backend != "slurm") {
+    throw InputError("--backend: '" + opt.backend + "' is not local or slurm");
+  }
+  if (opt.jobs < 0) throw InputError("--jobs: " + std::to_string(opt.jobs) + " must be >= 1");
+  if (opt.backend == "local" && (opt.wait || !opt.sbatch_args.empty())) {
+    throw InputError(std::string(opt.wait ? "--wait" : "--sbatch-arg") + ": only for --backend slurm");
+  }
+}
+
+// DIR is new, empty, or a sweep folder; then it exists.
+void makeSweepFolder(const SweepDir& dir) {
+  if (fs::exists(dir.path()) && !fs::is_directory(dir.path())) {
+    throw InputError("--out: " + dir.path().string() + " exists and is not a directory");
+  }
+  if (fs::exists(dir.path()) && !fs::is_empty(dir.path()) && !fs::exists(dir.path() / "commands.txt")) {
+    throw InputError("--out: " + dir.path().string() + " holds files but no sweep; use a new or empty folder");
+  }
+  makeOutputDir(dir.path());
+}
+
+fs::path selfExe() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw std::runtime_error("cannot find the tgnav program (/proc/self/exe): " + ec.message());
+  return exe;
+}
+
+// Builds each scene's feature map once, before the trials that share it start.
+void prebuildMaps(const SweepRun& run) {
+  std::map<std::string, const SweepTrial*> scenes;  // a trial of each scene
+  for (std::size_t i : run.todo) scenes.emplace(run.trials[i].scene, &run.trials[i]);
+  const fs::path cache = run.map_cache.empty() ? defaultCacheDir() : fs::path(run.map_cache);
+  for (const auto& [scene, trial] : scenes) {
+    std::vector<std::string> set;  // the trial's own settings: one may name another scene
+    for (const auto& [key, value] : trial->set) set.push_back(key + "=" + value);
+    const YamlDoc overrides = YamlDoc::fromOverrides(set);
+    const Scenario s = loadScenario(trial->scenario, &overrides);
+    bool told = false;
+    cachedFeatureMap(s.scene, MapBuildConfig{}, cache, [&](int, int) {
+      if (!told) {
+        std::fprintf(stderr, "tgnav sweep: building the feature map of %s (once; the trials share it)\n",
+                     scene.c_str());
+        told = true;
+      }
+    });
+  }
+}
+
+// The sweep's trials, their states after tidying, and which of them are not done.
+SweepRun planRun(const SweepDir& dir, const Sweep& sweep) {
+  SweepRun run;
+  run.dir = &dir;
+  run.trials = sweep.trials;
+  dir.tidy(run.trials, dir.inspect(run.trials));
+  run.folders = dir.writeIndex(run.trials);
+  for (std::size_t i = 0; i < run.trials.size(); ++i) {
+    if (run.folders[i].state != TrialState::kDone) run.todo.push_back(i);
+  }
+  return run;
+}
+
+}  // namespace
+
+int runSweep(const SweepOptions& opt) {
+  checkOptions(opt);
+  const SweepDir dir(opt.out);
+  const Sweep sweep = loadSweep(opt.sweep);
+  makeSweepFolder(dir);
+  const FolderLock lock(dir.path() / ".lock", /*inherit=*/true, 120.0,
+                        "tgnav sweep: " + dir.path().string() +
+                            " is locked (another sweep, or the trials of a killed one still stopping); waiting...");
+  dir.prepare(sweep);
+  refuseWhileSlurmRuns(dir);
+  SweepRun run = planRun(dir, sweep);
+  if (run.todo.empty()) {
+    std::printf("tgnav sweep: all %zu trials are done (%s) -> %s/index.csv\n", run.trials.size(),
+                statusList(countTrials(run.folders)).c_str(), dir.path().c_str());
+    return 0;
+  }
+  run.map_cache = opt.map_cache;
+  prebuildMaps(run);
+  run.program = opt.program.empty() ? selfExe() : fs::absolute(opt.program);
+  if (opt.backend == "local") return runLocal(run, opt.jobs);
+  return runSlurm(run, SlurmOptions{opt.jobs, opt.wait, opt.sbatch_args});
+}
+
+SweepStatus sweepStatus(const fs::path& path) {
+  if (path.empty()) throw InputError("--out: required");
+  const SweepDir dir(path);
+  const std::vector<SweepTrial> trials = dir.manifest();
+  SweepStatus status;
+  status.dir = dir.path();
+  status.trials = trials.size();
+  status.counts = countTrials(dir.writeIndex(trials));
+  status.running = dir.staging();
+  status.slurm = slurmStatus(dir);
+  return status;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,27 @@
+#pragma once
+// Loaders for 2D occupancy grids from the two common formats: ROS map_server maps (YAML + PGM)
+// and MovingAI benchmark .map files. Both put image row 0 at the top of the map (largest y),
+// while OccupancyGrid2D stores rows from the lowest y, so every loader flips rows. Bad input
+// throws InputError naming the file, the key or line, and the offending value.
+#include <filesystem>
+
+#include "planner/occupancy_grid.h"
+
+namespace tgnav::harness {
+
+// A map_server YAML (keys image, resolution, origin [x, y, yaw], occupied_thresh, free_thresh,
+// negate; optional mode, only "trinary") and the P5/P2 PGM it names (relative to the YAML's
+// directory unless absolute). occ = (maxval - pixel) / maxval, or pixel / maxval with negate: 1;
+// a cell is free only when occ < free_thresh, and both occupied and unknown are stored occupied.
+// origin yaw must be 0: the grid type has no rotation.
+planner::OccupancyGrid2D loadRosMap(const std::filesystem::path& yaml);
+
+// A MovingAI .map ("type octile", "height H", "width W", "map", then H rows of W characters).
+// '.', 'G' and 'S' are passable; every other character, including ones the format does not
+// define, is an obstacle. Origin (0, 0); `resolution_m` must be > 0.
+planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, double resolution_m);
+
+// By extension: .yaml/.yml -> loadRosMap, .map -> loadMovingAiMap (with movingai_resolution_m).
+planner::OccupancyGrid2D loadGridMap(const std::filesystem::path& file, double movingai_resolution_m);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,46 @@
+#pragma once
+// One planning run on a scene's feature map (the "plan" stage of `tgnav plan` and `tgnav trial`):
+// the dense voxel map, then the chosen planner, timed, and its plan.json.
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "control/trajectory.h"
+#include "harness/config/scenario.h"
+#include "planner/feature_map.h"
+#include "planner/planner.h"
+#include "planner/trajectory_generator.h"
+#include "planner/voxel_map.h"
+
+namespace tgnav::harness {
+
+// planner::parsePlannerKind, with an InputError naming `option` for an unknown name.
+planner::PlannerKind parsePlannerName(const std::string& text, const std::string& option);
+
+struct PlanRun {
+  planner::PlannerKind planner = planner::PlannerKind::kProposed;
+  std::uint64_t seed = 0;
+  int rrt_samples = 0;  // rrtstar only
+  planner::Plan plan;   // candidates, the chosen path and its homology class, per-class details
+  std::unique_ptr<planner::VoxelMap> voxels;
+  double voxel_map_s = 0.0;  // wall time: dense voxel map + distance field
+  double solve_s = 0.0;      // wall time: the planner itself
+  double plan_time_s() const { return voxel_map_s + solve_s; }
+  // The chosen path as a flyable trajectory (status kFailed with an empty trajectory when there
+  // is no path or it cannot be flown); not part of plan_time_s.
+  planner::TrajectoryReport trajectory;
+  double trajectory_s = 0.0;  // wall time: trajectory generation
+};
+
+// Box of the dense voxel map: the scene's bounds widened by `margin_m` (walls lie just outside
+// the free-space bounds and must be inside the box to be seen and avoided).
+PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind name,
+                   std::uint64_t seed, int rrt_samples);
+
+nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
+// The generated trajectory sampled at the configured rate, as the controller takes it (and
+// `tgnav fly --trajectory` reads it back from trajectory.csv). Requires a trajectory.
+control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,306 @@
+#include "harness/run/trial.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "control/state_estimator.h"
+#include "harness/base/errors.h"
+#include "harness/run/vo_pipeline.h"
+#include "harness/sim/camera.h"
+#include "harness/sim/egl_context.h"
+#include "harness/sim/imu_sim.h"
+#include "harness/sim/mujoco_sim.h"
+
+namespace tgnav::harness {
+
+std::uint64_t trialSeed(std::uint64_t seed, std::uint64_t stream) {
+  // splitmix64 of the seed offset by the stream: independent, well-mixed streams.
+  std::uint64_t z = seed + stream * 0x9E3779B97F4A7C15ULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+namespace {
+
+// Height above the landed pose from which a touch of the ground is a crash.
+constexpr double kLiftOffM = 0.1;
+
+// The other party of a contact involving the vehicle, or -1 when the contact does not involve it.
+int contactPartner(const mjModel* m, const mjContact& c, int vehicle_root) {
+  const bool g1 = m->body_rootid[m->geom_bodyid[c.geom1]] == vehicle_root;
+  const bool g2 = m->body_rootid[m->geom_bodyid[c.geom2]] == vehicle_root;
+  if (g1 == g2) return -1;
+  return g1 ? c.geom2 : c.geom1;
+}
+
+std::string geomName(const mjModel* m, int geom) {
+  const char* name = mj_id2name(m, mjOBJ_GEOM, geom);
+  if (name != nullptr && name[0] != '\0') return name;
+  const char* body = mj_id2name(m, mjOBJ_BODY, m->geom_bodyid[geom]);
+  return "geom " + std::to_string(geom) + (body != nullptr ? std::string(" of body ") + body : std::string());
+}
+
+std::string frameCaption(const vo::FrameResult& r) {
+  std::ostringstream s;
+  s.precision(1);
+  s << std::fixed << "t=" << r.t_s << " s " << vo::toString(r.status) << " (" << r.inliers << " inliers)";
+  return s.str();
+}
+
+Eigen::Vector3d positionAt(const FlightResult& flight, double t_s) {
+  Eigen::Vector3d p = flight.log.empty() ? Eigen::Vector3d::Zero() : flight.log.front().state.p_WB;
+  for (const FlightSample& f : flight.log) {
+    if (f.t_s > t_s + 1e-9) break;
+    p = f.state.p_WB;
+  }
+  return p;
+}
+
+// Frames kept for the strip: `count` evenly spread over the planned flight's frames.
+std::set<long> stripFrames(int count, double end_s, double camera_rate_hz) {
+  const auto planned_frames = static_cast<long>(std::floor(end_s * camera_rate_hz + 1e-9)) + 1;
+  std::set<long> strip;
+  for (int i = 0; i < count; ++i) {
+    strip.insert(count == 1 ? planned_frames / 2
+                            : std::lround(static_cast<double>(i) * (planned_frames - 1) / (count - 1)));
+  }
+  return strip;
+}
+
+// The flight of a trial with everything that runs beside the controller: the onboard camera and
+// the VO pipeline, the IMU and the estimator (state source vo), contact and bounds checks, progress.
+class ClosedLoop {
+ public:
+  ClosedLoop(const Scenario& scenario, const TrialOptions& options, const control::SetpointTrajectory& trajectory,
+             TrialResult* result)
+      : scenario_(scenario),
+        cfg_(scenario.trial),
+        trajectory_(trajectory),
+        result_(result),
+        model_(loadModel(scenario.scene.mjcf)),
+        data_(makeData(model_.get())),
+        view_(makeData(model_.get())),
+        ids_(VehicleIds::find(model_.get(), scenario.scene.mjcf.string())),
+        landed_(placeOnGround(scenario.scene, model_.get(), data_.get(), ids_)),
+        loop_(model_.get(), data_.get(), ids_, scenario.controller),
+        steps_per_frame_(stepsPerTick(model_.get(), cfg_.camera_rate_hz, "trial.camera_rate_hz =")),
+        timeline_(flightTimeline(loop_, trajectory, cfg_.flight)),
+        camera_(model_.get(), gl_, scenario.camera, 0),  // renders noiseless; noise in the VO stage
+        noise_(scenario.camera, trialSeed(options.seed, 1)),
+        imu_(cfg_.imu, ids_, trialSeed(options.seed, 2)),
+        estimator_(cfg_.estimator, loop_.vehicle().gravity_m_s2),
+        strip_(stripFrames(options.strip_frames, timeline_.end_s, cfg_.camera_rate_hz)),
+        fly_on_vo_(cfg_.state_source == StateSource::kVo),
+        reinitialise_(scenario.vo.reinitialise_after_lost),
+        vehicle_root_(model_->body_rootid[ids_.body]) {
+    result_->planned_flight_s = timeline_.end_s;
+    result_->X_BC = cameraInBody(model_.get(), mj_name2id(model_.get(), mjOBJ_CAMERA, scenario.camera.name.c_str()));
+    X_CB_ = result_->X_BC.inverse();
+    estimator_.reset(loop_.state(), loop_.time());
+  }
+
+  TrialEvents fly(const ProgressFn& progress, const std::atomic<bool>* interrupt) {
+    progress_ = progress;
+    interrupt_ = interrupt;
+    RgbdFrame first = render();
+    odometry_ = std::make_unique<vo::RgbdOdometry>(camera_.intrinsics(), scenario_.vo, first.X_WC);
+    pipeline_ = std::make_unique<VoPipeline>(*odometry_, noise_, reinitialise_, cfg_.pipeline);
+    pipeline_->submit(std::move(first), strip_.count(0) > 0);
+    FlightHooks hooks;
+    if (fly_on_vo_) hooks.control_state = [this](const FlightLoop&) { return estimator_.state(); };
+    hooks.after_step = [this](const FlightLoop& l) { return afterStep(l); };
+    wall0_ = std::chrono::steady_clock::now();
+    result_->flight = flyTrajectory(loop_, trajectory_, cfg_.flight, hooks);
+    collectFrames(pipeline_->finish());
+    result_->flight_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+    result_->sim_time_s = data_->time;
+    result_->vo_fused = estimator_.fused();
+    result_->vo_rejected = estimator_.rejected();
+    return events();
+  }
+
+ private:
+  // Puts the vehicle on the ground at the start, facing the start yaw, and returns that pose.
+  static planner::Pose4 placeOnGround(const SceneConfig& scene, const mjModel* m, mjData* d, const VehicleIds& ids) {
+    planner::Pose4 landed = scene.start;
+    landed.p_WB.z() = scene.bounds_min_m.z() + kLandedHeightM;
+    setVehiclePose(m, d, ids, landed);
+    return landed;
+  }
+
+  RgbdFrame render() {
+    mj_copyData(view_.get(), model_.get(), data_.get());
+    mj_kinematics(model_.get(), view_.get());
+    mj_camlight(model_.get(), view_.get());
+    return camera_.renderNoiseless(view_.get());
+  }
+
+  std::string afterStep(const FlightLoop& l) {
+    const control::ImuSample sample = imu_.sample(data_.get());
+    if (fly_on_vo_) estimator_.propagate(sample);
+    if (std::string stop = checkContactsAndBounds(l); !stop.empty()) return stop;
+    if (l.steps() % steps_per_frame_ == 0) cameraTick(l);
+    if (interrupt_ != nullptr && interrupt_->load()) {
+      interrupted_ = true;
+      return "interrupted";
+    }
+    return std::string();
+  }
+
+  // Once the vehicle has climbed clear of the ground, any contact is a collision (before, it
+  // settles and lifts off on the floor).
+  std::string checkContactsAndBounds(const FlightLoop& l) {
+    const mjData* d = data_.get();
+    const Eigen::Vector3d p = l.state().p_WB;
+    int partner = -1;
+    for (int i = 0; i < d->ncon && partner < 0; ++i)
+      partner = contactPartner(model_.get(), d->contact[i], vehicle_root_);
+    if (p.z() > landed_.p_WB.z() + kLiftOffM) airborne_ = true;
+    if (partner >= 0 && airborne_) {
+      result_->collision = TrialEvent{l.time(), p, geomName(model_.get(), partner)};
+      return "collision with " + result_->collision->what + " at " + formatPoint(p);
+    }
+    constexpr double kBoundsSlackM = 1.0;
+    const SceneConfig& scene = scenario_.scene;
+    if ((p.array() < scene.bounds_min_m.array() - kBoundsSlackM).any() ||
+        (p.array() > scene.bounds_max_m.array() + kBoundsSlackM).any()) {
+      left_bounds_ = true;
+      return "left the scene at " + formatPoint(p);
+    }
+    return std::string();
+  }
+
+  // Renders this frame first (the state is settled), then fuses the previous frame's pose, which
+  // the controller uses from now on: the VO of frame k-1 overlaps the render of k. A VO pose is
+  // fused one camera period after its image; rendering stops once tracking is lost for good (the
+  // frames after it are not scored).
+  void cameraTick(const FlightLoop& l) {
+    ++frame_index_;
+    const bool stop_rendering = fly_on_vo_ ? vo_failed_known_ : (!reinitialise_ && pipeline_->failedForGood());
+    if (!stop_rendering) pipeline_->submit(render(), strip_.count(frame_index_) > 0);
+    if (fly_on_vo_ && fused_up_to_ < frame_index_ - 1 && !vo_failed_known_) fuseResult(frame_index_ - 1);
+    if (progress_) reportProgress(l);
+  }
+
+  void fuseResult(long k) {
+    const VoPipeline::Done d = pipeline_->result(static_cast<std::size_t>(k));
+    fused_up_to_ = k;
+    if (d.vo.status == vo::TrackingStatus::kLost) {
+      if (!reinitialise_) vo_failed_known_ = true;  // among the fused results: the same in both modes
+      return;
+    }
+    estimator_.fusePose(d.vo.t_s, d.vo.X_WC * X_CB_);
+  }
+
+  void reportProgress(const FlightLoop& l) const {
+    TrialProgress pr;
+    pr.sim_s = l.time();
+    pr.sim_total_s = timeline_.end_s;
+    const double on_traj = l.time() - timeline_.trajectory_start_s;
+    const double traj_s = trajectory_.endTime() - trajectory_.startTime();
+    pr.path_fraction = traj_s > 0 ? std::clamp(on_traj / traj_s, 0.0, 1.0) : 1.0;
+    pr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+    progress_(pr);
+  }
+
+  // Frames up to the first loss (all of them when the VO re-initialises).
+  void collectFrames(std::vector<VoPipeline::Done> done) {
+    for (VoPipeline::Done& d : done) {
+      const bool lost = d.vo.status == vo::TrackingStatus::kLost;
+      if (!d.image.empty()) {
+        result_->strip_captions.push_back(frameCaption(d.vo));
+        result_->strip.push_back(d.image);
+      }
+      result_->frames.push_back(TrialFrame{d.vo, d.X_WC_true});
+      if (lost && !result_->vo_lost) {
+        result_->vo_lost = TrialEvent{d.vo.t_s, positionAt(result_->flight, d.vo.t_s), d.vo.reason};
+      }
+      if (lost && !reinitialise_) break;
+    }
+  }
+
+  TrialEvents events() {
+    const Eigen::Vector3d final_p = result_->flight.log.empty() ? Eigen::Vector3d::Zero() : loop_.state().p_WB;
+    result_->final_distance_to_goal_m = (final_p - scenario_.scene.goal.p_WB).norm();
+    TrialEvents e;
+    e.interrupted = interrupted_;
+    e.collision = result_->collision;
+    e.flight_completed = result_->flight.status == FlightStatus::kCompleted;
+    e.flight_reason = result_->flight.reason;
+    e.left_bounds = left_bounds_;
+    e.vo_lost = result_->vo_lost;
+    e.final_distance_to_goal_m = result_->final_distance_to_goal_m;
+    e.goal_radius_m = cfg_.goal_radius_m;
+    e.sim_time_s = result_->sim_time_s;
+    e.planned_end_s = timeline_.end_s;
+    e.frames = static_cast<int>(result_->frames.size());
+    return e;
+  }
+
+  const Scenario& scenario_;
+  const TrialConfig& cfg_;
+  const control::SetpointTrajectory& trajectory_;
+  TrialResult* result_;
+  ModelPtr model_;
+  DataPtr data_;
+  DataPtr view_;
+  VehicleIds ids_;
+  planner::Pose4 landed_;
+  FlightLoop loop_;
+  int steps_per_frame_;
+  FlightTimeline timeline_;
+  EglContext gl_;
+  Camera camera_;
+  CameraNoise noise_;
+  SimulatedImu imu_;
+  control::StateEstimator estimator_;
+  std::set<long> strip_;
+  bool fly_on_vo_;
+  bool reinitialise_;
+  int vehicle_root_;
+  Eigen::Isometry3d X_CB_ = Eigen::Isometry3d::Identity();
+  std::unique_ptr<vo::RgbdOdometry> odometry_;
+  std::unique_ptr<VoPipeline> pipeline_;
+  ProgressFn progress_;
+  const std::atomic<bool>* interrupt_ = nullptr;
+  std::chrono::steady_clock::time_point wall0_;
+  long frame_index_ = 0;
+  long fused_up_to_ = -1;
+  bool vo_failed_known_ = false;
+  bool airborne_ = false;
+  bool interrupted_ = false;
+  bool left_bounds_ = false;
+};
+
+}  // namespace
+
+TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
+                     const ProgressFn& progress, const std::atomic<bool>* interrupt) {
+  TrialResult result;
+  result.plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples);
+  const planner::Plan& plan = result.plan.plan;
+  if (plan.chosen < 0 || !result.plan.trajectory.trajectory) {
+    result.status = TrialStatus::kPlanFailed;
+    result.detail = plan.chosen < 0 ? std::string("no path: ") + planner::toString(plan.status)
+                                    : "trajectory generation failed: " + result.plan.trajectory.reason;
+    return result;
+  }
+  if (interrupt != nullptr && interrupt->load()) {
+    result.status = TrialStatus::kInterrupted;
+    result.detail = "interrupted after planning";
+    return result;
+  }
+  result.setpoints = setpoints(result.plan, scenario.planner.trajectory.sample_rate_hz);
+  ClosedLoop closed_loop(scenario, options, *result.setpoints, &result);
+  const TrialVerdict verdict = decideStatus(closed_loop.fly(progress, interrupt));
+  result.status = verdict.status;
+  result.detail = verdict.detail;
+  return result;
+}
+
+}  // namespace tgnav::harness

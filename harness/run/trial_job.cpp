@@ -1,0 +1,175 @@
+#include "harness/run/trial_job.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <opencv2/core/utility.hpp>
+#include <sstream>
+
+#include "harness/base/errors.h"
+#include "harness/base/process.h"
+#include "harness/config/yaml_util.h"
+#include "harness/io/frame_strip.h"
+#include "harness/io/staged_output.h"
+#include "harness/io/topdown.h"
+#include "harness/io/trajectory_csv.h"
+#include "harness/run/map_cache.h"
+#include "harness/run/trial_metrics.h"
+#include "vo/tum.h"
+
+namespace tgnav::harness {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Pixels across the map layer of the figures.
+constexpr double kLayerPixels = 800.0;
+
+void checkJob(const TrialJob& job) {
+  if (job.samples != 0 && job.planner != planner::PlannerKind::kRrtStar) {
+    throw InputError("--samples: only the rrtstar planner takes a sample budget");
+  }
+  if (job.samples < 0) throw InputError("--samples: " + std::to_string(job.samples) + " must be >= 1");
+  if (job.frames < 0 || job.frames > 64) {
+    throw InputError("--frames: " + std::to_string(job.frames) + " must be between 0 and 64");
+  }
+  if (job.threads < 0) throw InputError("--threads: " + std::to_string(job.threads) + " must be >= 1");
+}
+
+// --out must be new or empty unless --force.
+void checkOutput(const fs::path& requested, bool force) {
+  fs::path out = fs::absolute(requested).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec)) throw InputError("--out: " + requested.string() + " exists and is not a directory");
+  if (!fs::is_empty(out, ec) && !force) {
+    const bool complete = fs::exists(out / "metrics.json", ec);
+    throw InputError("--out: " + requested.string() + " already holds " +
+                     (complete ? "the results of a trial" : "files") + "; use --force to replace them");
+  }
+}
+
+// Caps the threads the trial uses (a sweep runs one trial per core): the planner's, OpenCV's and
+// llvmpipe's rasteriser threads (unless LP_NUM_THREADS is set), and one thread renders and
+// tracks in turn. The results do not depend on it.
+void limitThreads(int threads, Scenario* scenario) {
+  scenario->planner.perception.threads = threads;
+  if (threads == 1) scenario->trial.pipeline = false;
+  cv::setNumThreads(threads);
+  setenv("LP_NUM_THREADS", std::to_string(threads).c_str(), /*overwrite=*/0);
+}
+
+std::string voCsv(const TrialResult& r) {
+  std::ostringstream out;
+  out.precision(6);
+  out << std::fixed;
+  out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,reason\n";
+  for (const TrialFrame& f : r.frames) {
+    const Eigen::Vector3d p = f.X_WC_true.translation();
+    const Eigen::Vector3d e = f.vo.X_WC.translation();
+    out << f.vo.t_s << ',' << vo::toString(f.vo.status) << ',' << f.vo.features << ',' << f.vo.with_depth << ','
+        << f.vo.matches << ',' << f.vo.inliers << ',' << (f.vo.keyframe ? 1 : 0) << ',' << p.x() << ',' << p.y() << ','
+        << p.z() << ',';
+    if (f.tracked()) {
+      out << e.x() << ',' << e.y() << ',' << e.z();
+    } else {
+      out << ",,";
+    }
+    std::string reason = f.vo.reason;
+    for (char& c : reason) c = (c == ',' || c == '\n') ? ';' : c;
+    out << ',' << reason << '\n';
+  }
+  return out.str();
+}
+
+std::string configYaml(const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
+  std::ostringstream config;
+  config << "# tgnav trial --planner " << planner::toString(options.planner);
+  if (options.planner == planner::PlannerKind::kRrtStar) config << " --samples " << r.plan.rrt_samples;
+  config << " --seed " << options.seed << "\n" << resolvedScenarioYaml(scenario);
+  return config.str();
+}
+
+void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
+  writeFileAtomic(d / "config.yaml", configYaml(scenario, options, r));
+  writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");
+  if (r.setpoints) writeFileAtomic(d / "trajectory.csv", trajectoryCsv(*r.setpoints));
+  writeFileAtomic(d / "gt.tum", vo::toTum(cameraPoses(r.flight, r.X_BC)));
+  std::vector<vo::StampedPose> est;
+  for (const TrialFrame& f : r.frames) {
+    if (f.tracked()) est.push_back(vo::StampedPose{f.vo.t_s, f.vo.X_WC});
+  }
+  writeFileAtomic(d / "est.tum", vo::toTum(est));
+  writeFileAtomic(d / "vo.csv", voCsv(r));
+  if (!r.strip.empty()) writeImageAtomic(d / "frames.png", drawFrameStrip(r.strip, r.strip_captions));
+}
+
+void writeMapLayerOf(const fs::path& d, const Scenario& scenario, const planner::FeatureMap& map) {
+  const SceneConfig& scene = scenario.scene;
+  Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / kLayerPixels);
+  topdown.drawMap(map, scenario.planner.perception.slice_half_height_m);
+  writeMapLayer(d, topdown.layer(scene.source.stem().string()));
+}
+
+std::string summaryLine(const Scenario& scenario, const TrialOptions& options, const TrialResult& r,
+                        const TrialScores& scores, const TrialTiming& timing, const fs::path& out) {
+  std::ostringstream line;
+  line.precision(3);
+  line << "tgnav trial: " << scenario.scene.source.stem().string() << ' ' << planner::toString(options.planner)
+       << " seed " << options.seed << ": " << toString(r.status) << " (" << r.detail << ")";
+  if (r.status != TrialStatus::kPlanFailed) {
+    line << "; flown " << scores.path_length_m << " m, goal error "
+         << (scores.goal_error_m ? std::to_string(*scores.goal_error_m).substr(0, 5) + " m" : std::string("n/a"))
+         << ", ATE " << scores.ate_rmse_m << " m over " << scores.vo_frames << " frames, plan " << timing.plan_time_s
+         << " s, real-time factor " << (r.flight_wall_s > 0 ? r.sim_time_s / r.flight_wall_s : 0.0);
+  }
+  line << " -> " << out.string() << "/";
+  return line.str();
+}
+
+}  // namespace
+
+TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, const std::atomic<bool>* interrupt) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  checkJob(job);
+  const YamlDoc overrides = YamlDoc::fromOverrides(job.set);
+  Scenario scenario = loadScenario(job.scenario, &overrides);
+  if (job.seed) scenario.seed = *job.seed;
+  if (job.threads > 0) limitThreads(job.threads, &scenario);
+  const TrialOptions options{job.planner, job.samples, scenario.seed, job.frames};
+  checkOutput(job.out, job.force);
+  StagedDir staged(job.out);
+  const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial");
+
+  if (job.trial_starting) job.trial_starting();
+  const TrialResult r = runTrial(scenario, map, options, progress, interrupt);
+  if (job.trial_ended) job.trial_ended();
+  const TrialScores scores = scoreTrial(r);
+  TrialTiming timing;
+  timing.plan_time_s = r.plan.plan_time_s();
+  timing.trajectory_s = r.plan.trajectory_s;
+  timing.flight_wall_s = r.flight_wall_s;
+  timing.peak_rss_mb = peakRssMb();
+  timing.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+  const fs::path& d = staged.staging();
+  writeData(d, scenario, options, r);
+  writeMapLayerOf(d, scenario, map);
+  TrialJobResult result;
+  if (r.status == TrialStatus::kInterrupted) {
+    writeFileAtomic(d / "INCOMPLETE", "interrupted: " + r.detail + "; these results are partial\n");
+  } else {
+    // Last: a folder with metrics.json is a finished trial.
+    writeFileAtomic(d / "metrics.json", trialMetricsJson(scenario, options, r, scores, timing).dump(2) + "\n");
+    if (job.figures) result.figures = drawFigures("trial", d, job.figure_format);
+  }
+  staged.commit(OnExisting::kReplace);
+  result.out = staged.target();
+  result.status = r.status;
+  result.summary =
+      r.status == TrialStatus::kInterrupted ? r.detail : summaryLine(scenario, options, r, scores, timing, result.out);
+  return result;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,132 @@
+#include "harness/run/trial_metrics.h"
+
+#include <cmath>
+
+#include "vo/metrics.h"
+
+namespace tgnav::harness {
+
+std::vector<vo::StampedPose> cameraPoses(const FlightResult& flight, const Eigen::Isometry3d& X_BC) {
+  std::vector<vo::StampedPose> poses;
+  poses.reserve(flight.log.size());
+  for (const FlightSample& f : flight.log) {
+    Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
+    X_WB.linear() = f.state.q_WB.toRotationMatrix();
+    X_WB.translation() = f.state.p_WB;
+    poses.push_back(vo::StampedPose{f.t_s, X_WB * X_BC});
+  }
+  return poses;
+}
+
+TrialScores scoreTrial(const TrialResult& result) {
+  TrialScores s;
+  const planner::Plan& plan = result.plan.plan;
+  if (plan.chosen >= 0) s.planned_length_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].length_m;
+  s.trajectory_length_m = result.plan.trajectory.length_m;
+  for (std::size_t i = 1; i < result.flight.log.size(); ++i) {
+    s.path_length_m += (result.flight.log[i].state.p_WB - result.flight.log[i - 1].state.p_WB).norm();
+  }
+
+  std::vector<vo::PosePair> pairs;
+  double distance = 0.0;
+  for (std::size_t i = 0; i < result.frames.size(); ++i) {
+    const TrialFrame& f = result.frames[i];
+    if (i > 0) distance += (f.X_WC_true.translation() - result.frames[i - 1].X_WC_true.translation()).norm();
+    switch (f.vo.status) {
+      case vo::TrackingStatus::kOk:
+        ++s.vo_ok;
+        break;
+      case vo::TrackingStatus::kWeak:
+        ++s.vo_weak;
+        break;
+      case vo::TrackingStatus::kLost:
+        ++s.vo_lost;
+        break;
+    }
+    if (!f.tracked()) continue;
+    pairs.push_back(vo::PosePair{f.vo.t_s, f.vo.X_WC, f.X_WC_true});
+    s.distance_tracked_m = distance;
+  }
+  s.vo_frames = static_cast<int>(result.frames.size());
+  if (!pairs.empty()) {
+    const vo::AteResult anchored = vo::absoluteTrajectoryError(pairs, false);
+    s.ate_anchored_rmse_m = anchored.rmse_m;
+    s.ate_max_m = anchored.max_m;
+    s.ate_rmse_m = vo::absoluteTrajectoryError(pairs, true).rmse_m;
+    // The goal error needs an estimate at the end of the flight.
+    if (result.frames.back().tracked() && result.status != TrialStatus::kInterrupted) {
+      s.goal_error_m = vo::goalError(pairs);
+    }
+  }
+  return s;
+}
+
+nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOptions& options,
+                                        const TrialResult& result, const TrialScores& scores,
+                                        const TrialTiming& timing) {
+  using nlohmann::ordered_json;
+  auto orNull = [](const std::optional<double>& v) { return v ? ordered_json(*v) : ordered_json(nullptr); };
+  auto point = [](const Eigen::Vector3d& p) { return ordered_json::array({p.x(), p.y(), p.z()}); };
+  ordered_json j;
+  j["scenario"] = scenario.source.string();
+  j["scene"] = scenario.scene.source.stem().string();
+  j["planner"] = toString(options.planner);
+  j["samples"] =
+      options.planner == planner::PlannerKind::kRrtStar ? ordered_json(result.plan.rrt_samples) : ordered_json(nullptr);
+  j["seed"] = options.seed;
+  j["state_source"] = toString(scenario.trial.state_source);
+  j["status"] = toString(result.status);
+  j["detail"] = result.detail;
+  j["path_length_m"] = scores.path_length_m;
+  j["planned_length_m"] = scores.planned_length_m;
+  j["trajectory_length_m"] = scores.trajectory_length_m;
+  j["goal_error_m"] = orNull(scores.goal_error_m);
+  j["final_distance_to_goal_m"] = result.final_distance_to_goal_m;
+  j["ate_rmse_m"] = scores.ate_rmse_m;
+  j["ate_anchored_rmse_m"] = scores.ate_anchored_rmse_m;
+  j["ate_max_m"] = scores.ate_max_m;
+  j["vo_frames"] = scores.vo_frames;
+  j["vo_ok"] = scores.vo_ok;
+  j["vo_weak"] = scores.vo_weak;
+  j["vo_lost_frames"] = scores.vo_lost;
+  j["vo_lost_at_s"] = result.vo_lost ? ordered_json(result.vo_lost->t_s) : ordered_json(nullptr);
+  j["vo_lost_position"] = result.vo_lost ? point(result.vo_lost->p_WB) : ordered_json(nullptr);
+  j["vo_lost_reason"] = result.vo_lost ? ordered_json(result.vo_lost->what) : ordered_json(nullptr);
+  j["distance_tracked_m"] = scores.distance_tracked_m;
+  j["collision"] = result.collision ? ordered_json{{"t_s", result.collision->t_s},
+                                                   {"position", point(result.collision->p_WB)},
+                                                   {"with", result.collision->what}}
+                                    : ordered_json(nullptr);
+  const planner::Plan& plan = result.plan.plan;
+  j["plan_status"] = planner::toString(plan.status);
+  j["classes"] = result.plan.plan.topo.classes.size();
+  j["chosen_class"] =
+      result.plan.plan.chosen_class >= 0 ? ordered_json(result.plan.plan.chosen_class) : ordered_json(nullptr);
+  j["c_p_min"] = plan.chosen >= 0 && std::isfinite(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
+                     ? ordered_json(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
+                     : ordered_json(nullptr);
+  j["trajectory_status"] = planner::toString(result.plan.trajectory.status);
+  const TrackingSummary tracking = summarizeTracking(result.flight);
+  j["tracking_rmse_m"] = tracking.position_rmse_m;
+  j["vo_poses_fused"] = result.vo_fused;
+  j["vo_poses_rejected"] = result.vo_rejected;
+  j["camera"] = {{"width_px", scenario.camera.width_px},
+                 {"height_px", scenario.camera.height_px},
+                 {"rate_hz", scenario.trial.camera_rate_hz}};
+  j["sim_time_s"] = result.sim_time_s;
+  const double rtf = result.flight_wall_s > 0 ? result.sim_time_s / result.flight_wall_s : 0.0;
+  // Wall-clock figures: the documented names (README) at the top level, and all of them under `timing`.
+  j["plan_time_s"] = timing.plan_time_s;
+  j["wall_time_s"] = timing.wall_time_s;
+  j["real_time_factor"] = rtf;
+  j["peak_rss_mb"] = timing.peak_rss_mb;
+  j["timing"] = {{"plan_time_s", timing.plan_time_s},
+                 {"trajectory_s", timing.trajectory_s},
+                 {"flight_wall_s", timing.flight_wall_s},
+                 {"wall_time_s", timing.wall_time_s},
+                 {"real_time_factor", rtf},
+                 {"peak_rss_mb", timing.peak_rss_mb}};
+  return j;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,46 @@
+#pragma once
+// A closed-loop trial's outcome, decided from what happened during it. decideStatus is a pure
+// function of those events, so that its precedence (most severe first) is tested on its own.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+namespace tgnav::harness {
+
+enum class TrialStatus { kSuccess, kVoLost, kCollision, kDiverged, kTimeout, kPlanFailed, kInterrupted };
+const char* toString(TrialStatus status);  // "success", "vo_lost", ..., "incomplete"
+
+struct TrialEvent {
+  double t_s = 0.0;
+  Eigen::Vector3d p_WB = Eigen::Vector3d::Zero();  // true position then
+  std::string what;
+};
+
+// What happened in a flight that took off (a failed plan is decided before it).
+struct TrialEvents {
+  bool interrupted = false;
+  std::optional<TrialEvent> collision;
+  bool flight_completed = true;  // false: the flight loop diverged (flight_reason says how)
+  std::string flight_reason;
+  bool left_bounds = false;  // flight_reason says where
+  std::optional<TrialEvent> vo_lost;
+  double final_distance_to_goal_m = 0.0;
+  double goal_radius_m = 0.5;
+  double sim_time_s = 0.0;
+  double planned_end_s = 0.0;
+  int frames = 0;  // VO frames scored
+};
+
+struct TrialVerdict {
+  TrialStatus status = TrialStatus::kSuccess;
+  std::string detail;  // one line: what decided it
+};
+
+// Most severe first: interrupted, collision, diverged (or left the scene), VO lost, timeout (the
+// flight ended outside the goal radius), success.
+TrialVerdict decideStatus(const TrialEvents& events);
+
+// "(x, y, z)" with 2 decimals, as details and messages print positions.
+std::string formatPoint(const Eigen::Vector3d& p);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,170 @@
+#include "harness/sim/camera.h"
+
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <stdexcept>
+
+#include "harness/base/errors.h"
+
+namespace tgnav::harness {
+
+namespace {
+// Vehicle geoms live in group 2 (models/quadrotor.xml); the onboard camera must not see them.
+constexpr int kVehicleGeomGroup = 2;
+}  // namespace
+
+Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px) {
+  Intrinsics k;
+  k.width_px = width_px;
+  k.height_px = height_px;
+  k.fy = 0.5 * height_px / std::tan(0.5 * fovy_deg * M_PI / 180.0);
+  k.fx = k.fy;
+  // OpenGL's image centre lies between pixels; OpenCV puts pixel centres on integers.
+  k.cx = 0.5 * (width_px - 1);
+  k.cy = 0.5 * (height_px - 1);
+  return k;
+}
+
+Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed)
+    : model_(m), gl_(gl), config_(config), noise_(config, seed) {
+  cam_id_ = mj_name2id(m, mjOBJ_CAMERA, config_.name.c_str());
+  if (cam_id_ < 0) throw InputError("camera '" + config_.name + "' is not in the model");
+
+  m->vis.global.offwidth = std::max(m->vis.global.offwidth, config_.width_px);
+  m->vis.global.offheight = std::max(m->vis.global.offheight, config_.height_px);
+  m->vis.map.znear = static_cast<float>(config_.near_clip_m / m->stat.extent);
+  m->vis.map.zfar = static_cast<float>(config_.far_clip_m / m->stat.extent);
+  // What OpenGL will actually use (float precision of vis.map included).
+  near_m_ = m->vis.map.znear * m->stat.extent;
+  far_m_ = m->vis.map.zfar * m->stat.extent;
+  intrinsics_ = intrinsicsFromFovy(m->cam_fovy[cam_id_], config_.width_px, config_.height_px);
+
+  gl_.makeCurrent();
+  mjv_defaultCamera(&view_);
+  view_.type = mjCAMERA_FIXED;
+  view_.fixedcamid = cam_id_;
+  mjv_defaultOption(&option_);
+  option_.geomgroup[kVehicleGeomGroup] = 0;
+  mjv_defaultScene(&scene_);
+  mjv_makeScene(m, &scene_, 2000);
+  scene_.flags[mjRND_SHADOW] = 0;
+  scene_.flags[mjRND_REFLECTION] = 0;
+  scene_.flags[mjRND_SKYBOX] = 0;
+  mjr_defaultContext(&context_);
+  mjr_makeContext(m, &context_, mjFONTSCALE_100);
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  if (context_.currentBuffer != mjFB_OFFSCREEN) {
+    throw std::runtime_error("MuJoCo: offscreen framebuffer unavailable in this GL context");
+  }
+  rgb_buffer_.resize(3 * static_cast<std::size_t>(config_.width_px) * config_.height_px);
+  depth_buffer_.resize(static_cast<std::size_t>(config_.width_px) * config_.height_px);
+}
+
+Camera::~Camera() {
+  gl_.makeCurrent();
+  mjr_freeContext(&context_);
+  mjv_freeScene(&scene_);
+}
+
+namespace {
+// MuJoCo camera (x right, y up, z backward) -> vision camera (x right, y down, z forward).
+Eigen::Matrix3d mujocoToVision() { return Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal(); }
+}  // namespace
+
+Eigen::Isometry3d cameraInBody(const mjModel* m, int cam_id) {
+  const mjtNum* q = m->cam_quat + 4 * cam_id;
+  Eigen::Isometry3d X_BC = Eigen::Isometry3d::Identity();
+  X_BC.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix() * mujocoToVision();
+  X_BC.translation() = Eigen::Vector3d(m->cam_pos + 3 * cam_id);
+  return X_BC;
+}
+
+Eigen::Isometry3d Camera::pose(const mjData* d) const {
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+  Eigen::Matrix3d R_W_mj;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) R_W_mj(r, c) = d->cam_xmat[9 * cam_id_ + 3 * r + c];
+  }
+  X_WC.linear() = R_W_mj * mujocoToVision();
+  X_WC.translation() =
+      Eigen::Vector3d(d->cam_xpos[3 * cam_id_], d->cam_xpos[3 * cam_id_ + 1], d->cam_xpos[3 * cam_id_ + 2]);
+  return X_WC;
+}
+
+RgbdFrame Camera::render(mjData* d) {
+  RgbdFrame frame = renderNoiseless(d);
+  noise_.apply(&frame);
+  return frame;
+}
+
+RgbdFrame Camera::renderNoiseless(mjData* d) {
+  gl_.makeCurrent();
+  const int w = config_.width_px;
+  const int h = config_.height_px;
+  mjv_updateScene(model_, d, &option_, nullptr, &view_, mjCAT_ALL, &scene_);
+  // Several cameras may share one GL context: bind this camera's framebuffer every time.
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  const mjrRect viewport = {0, 0, w, h};
+  mjr_render(viewport, &scene_, &context_);
+  mjr_readPixels(rgb_buffer_.data(), depth_buffer_.data(), viewport, &context_);
+
+  RgbdFrame frame;
+  frame.t_s = d->time;
+  frame.X_WC = pose(d);
+  frame.bgr.create(h, w, CV_8UC3);
+  frame.depth_m.create(h, w, CV_32FC1);
+  const auto min_depth = static_cast<float>(config_.min_depth_m);
+  const auto max_depth = static_cast<float>(config_.max_depth_m);
+  // OpenGL rows run bottom-up; images run top-down.
+  for (int row = 0; row < h; ++row) {
+    const std::size_t src_row = static_cast<std::size_t>(h - 1 - row) * w;
+    auto* bgr = frame.bgr.ptr<cv::Vec3b>(row);
+    auto* depth = frame.depth_m.ptr<float>(row);
+    for (int col = 0; col < w; ++col) {
+      const unsigned char* rgb = &rgb_buffer_[3 * (src_row + col)];
+      bgr[col] = cv::Vec3b(rgb[2], rgb[1], rgb[0]);
+      const auto z = static_cast<float>(linearizeDepth(depth_buffer_[src_row + col], near_m_, far_m_));
+      depth[col] = (z >= min_depth && z <= max_depth) ? z : 0.0f;
+    }
+  }
+  return frame;
+}
+
+CameraNoise::CameraNoise(const CameraConfig& config, std::uint64_t seed)
+    : rgb_sigma_(config.rgb_noise_sigma),
+      depth_k_(config.depth_noise_sigma_per_m2),
+      min_depth_m_(config.min_depth_m),
+      max_depth_m_(config.max_depth_m),
+      // cv::RNG treats a zero state as a fixed non-zero one; keep every seed distinct from it.
+      rng_(seed ^ 0x9E3779B97F4A7C15ULL) {
+  config.validate();
+}
+
+void CameraNoise::apply(RgbdFrame* frame) {
+  if (rgb_sigma_ > 0.0) {
+    noise_.create(frame->bgr.size(), CV_32FC3);
+    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, rgb_sigma_);
+    cv::Mat noisy;
+    frame->bgr.convertTo(noisy, CV_32FC3);
+    noisy += noise_;
+    noisy.convertTo(frame->bgr, CV_8UC3);  // rounds and saturates
+  }
+  if (depth_k_ > 0.0) {
+    noise_.create(frame->depth_m.size(), CV_32FC1);
+    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, 1.0);
+    const auto k = static_cast<float>(depth_k_);
+    const auto lo = static_cast<float>(min_depth_m_);
+    const auto hi = static_cast<float>(max_depth_m_);
+    for (int row = 0; row < frame->depth_m.rows; ++row) {
+      auto* z = frame->depth_m.ptr<float>(row);
+      const auto* n = noise_.ptr<float>(row);
+      for (int col = 0; col < frame->depth_m.cols; ++col) {
+        if (z[col] <= 0.0f) continue;  // invalid stays invalid
+        const float noisy = z[col] + k * z[col] * z[col] * n[col];
+        z[col] = (noisy >= lo && noisy <= hi) ? noisy : 0.0f;
+      }
+    }
+  }
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,97 @@
+#pragma once
+// Forward RGB-D camera rendered offscreen by MuJoCo through an EGL context.
+//
+// Camera frame C follows the computer-vision convention (x right, y down, z forward along the
+// optical axis); MuJoCo's own camera frame (x right, y up, looking along -z) is converted here
+// and nowhere else. Pixel (u, v) = (column, row) with the origin at the centre of the top-left
+// pixel, as in OpenCV.
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "harness/config/camera_config.h"
+#include "harness/sim/egl_context.h"
+#include "vo/camera_intrinsics.h"
+
+namespace tgnav::harness {
+
+// The camera's intrinsics, in the form the VO takes them.
+using Intrinsics = vo::CameraIntrinsics;
+
+struct RgbdFrame {
+  double t_s = 0.0;
+  cv::Mat bgr;      // CV_8UC3, OpenCV channel order
+  cv::Mat depth_m;  // CV_32FC1, z along the optical axis in metres; 0 = invalid
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+};
+
+// The sensor noise of CameraConfig, seeded: Gaussian noise on every colour channel and depth
+// noise of sigma k z^2 on valid depths (a noisy depth outside [min, max] becomes invalid).
+// Frames must be noised in order for a seed to give the same noise.
+class CameraNoise {
+ public:
+  CameraNoise(const CameraConfig& config, std::uint64_t seed);
+  void apply(RgbdFrame* frame);
+
+ private:
+  double rgb_sigma_;
+  double depth_k_;
+  double min_depth_m_;
+  double max_depth_m_;
+  cv::RNG rng_;
+  cv::Mat noise_;  // scratch
+};
+
+class Camera {
+ public:
+  // Makes `gl` current and allocates MuJoCo's render context. Writes the offscreen buffer
+  // size and clipping planes this camera needs into m->vis (MuJoCo reads them from there).
+  Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed);
+  ~Camera();
+  Camera(const Camera&) = delete;
+  Camera& operator=(const Camera&) = delete;
+  Camera(Camera&&) = delete;
+  Camera& operator=(Camera&&) = delete;
+
+  // Renders the current state of `d` (kinematics must be up to date, e.g. after mj_step), with
+  // the configured noise.
+  RgbdFrame render(mjData* d);
+  // The same without noise: what a pipeline renders on one thread and noises on another.
+  RgbdFrame renderNoiseless(mjData* d);
+  // Pose of C in W for the current state of `d`.
+  Eigen::Isometry3d pose(const mjData* d) const;
+  const Intrinsics& intrinsics() const { return intrinsics_; }
+
+ private:
+  const mjModel* model_;
+  const EglContext& gl_;
+  CameraConfig config_;
+  Intrinsics intrinsics_;
+  int cam_id_ = -1;
+  double near_m_ = 0.0;
+  double far_m_ = 0.0;
+  mjvScene scene_{};
+  mjvCamera view_{};
+  mjvOption option_{};
+  mjrContext context_{};
+  std::vector<unsigned char> rgb_buffer_;
+  std::vector<float> depth_buffer_;
+  CameraNoise noise_;
+};
+
+// Pose of camera `cam_id` in its parent body's frame (vision convention), fixed by the model.
+Eigen::Isometry3d cameraInBody(const mjModel* m, int cam_id);
+
+// Intrinsics of a pinhole camera with vertical field of view `fovy_deg` and square pixels,
+// which is what MuJoCo renders.
+Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px);
+
+// Converts an OpenGL depth-buffer value in [0, 1] to metric z for the given clip planes.
+inline double linearizeDepth(double buffer, double near_m, double far_m) {
+  return near_m / (1.0 - buffer * (1.0 - near_m / far_m));
+}
+
+}  // namespace tgnav::harness
