@@ -4,12 +4,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "vo/check.h"
+
 namespace tgnav::vo {
 
 namespace {
-void require(bool ok, const std::string& field, double value, const std::string& rule) {
-  if (!ok) throw std::invalid_argument(field + " = " + std::to_string(value) + ": " + rule);
-}
 // ORB keeps only its globally strongest corners; ask for enough candidates that weakly
 // textured cells still have theirs when the grid picks per cell.
 constexpr int kCandidateFactor = 10;

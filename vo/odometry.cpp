@@ -10,16 +10,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "vo/check.h"
+
 namespace tgnav::vo {
 
 namespace {
-
-void require(bool ok, const std::string& field, double value, const std::string& rule) {
-  if (ok) return;
-  std::ostringstream msg;
-  msg << field << " = " << value << ": " << rule;
-  throw std::invalid_argument(msg.str());
-}
 
 double rotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 

@@ -3,16 +3,9 @@
 #include <stdexcept>
 #include <string>
 
-namespace tgnav::harness {
+#include "harness/config/check.h"
 
-namespace {
-template <typename T>
-void require(bool ok, const char* field, T value, const char* rule) {
-  if (!ok) {
-    throw std::invalid_argument(std::string(field) + " = " + std::to_string(value) + ": " + rule);
-  }
-}
-}  // namespace
+namespace tgnav::harness {
 
 void CameraConfig::validate() const {
   if (name.empty()) throw std::invalid_argument("name: must not be empty");

@@ -1,20 +1,16 @@
 #include "harness/config/flight_config.h"
 
-#include <stdexcept>
-#include <string>
+#include "harness/config/check.h"
 
 namespace tgnav::harness {
 
 void FlightConfig::validate() const {
-  auto positive = [](double v, const char* name) {
-    if (!(v > 0.0)) throw std::invalid_argument(std::string(name) + " = " + std::to_string(v) + ": must be > 0");
-  };
-  positive(takeoff_speed_m_s, "takeoff_speed_m_s");
-  if (!(settle_s >= 0.0)) throw std::invalid_argument("settle_s: must be >= 0");
-  if (!(hold_s >= 0.0)) throw std::invalid_argument("hold_s: must be >= 0");
-  positive(max_start_offset_m, "max_start_offset_m");
-  positive(diverged_tilt_rad, "diverged_tilt_rad");
-  positive(diverged_speed_m_s, "diverged_speed_m_s");
+  require(takeoff_speed_m_s > 0.0, "takeoff_speed_m_s", takeoff_speed_m_s, "must be > 0");
+  require(settle_s >= 0.0, "settle_s", settle_s, "must be >= 0");
+  require(hold_s >= 0.0, "hold_s", hold_s, "must be >= 0");
+  require(max_start_offset_m > 0.0, "max_start_offset_m", max_start_offset_m, "must be > 0");
+  require(diverged_tilt_rad > 0.0, "diverged_tilt_rad", diverged_tilt_rad, "must be > 0");
+  require(diverged_speed_m_s > 0.0, "diverged_speed_m_s", diverged_speed_m_s, "must be > 0");
 }
 
 }  // namespace tgnav::harness

@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "harness/config/check.h"
+
 namespace tgnav::harness {
 
 const std::vector<std::pair<std::string, StateSource>>& stateSourceNames() {
@@ -30,12 +32,6 @@ bool parseStateSource(const std::string& text, StateSource* source) {
 }
 
 namespace {
-void require(bool ok, const std::string& field, double value, const char* rule) {
-  if (ok) return;
-  std::ostringstream msg;
-  msg << field << " = " << value << ": " << rule;
-  throw std::invalid_argument(msg.str());
-}
 
 void nonNegative(double value, const char* field) {
   require(std::isfinite(value) && value >= 0.0, field, value, "must be >= 0");

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/io/staged_output.h"
 
 namespace tgnav::harness {
@@ -38,14 +39,6 @@ const std::vector<std::string> kIndexColumns = {"id",
                                                 "distance_tracked_m",
                                                 "folder"};
 const std::vector<std::string> kManifestColumns = {"id", "scenario", "scene", "planner", "samples", "seed", "params"};
-
-std::string readText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot read");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::vector<std::string> splitFields(const std::string& line, char sep) {
   std::vector<std::string> out;
@@ -156,7 +149,7 @@ class RowReader {
 void readMetrics(const fs::path& file, const std::string& shown, IndexRow& row) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(readText(file));
+    j = nlohmann::json::parse(readTextFile(file));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(shown + ": not valid JSON: " + e.what());
   }
@@ -279,10 +272,10 @@ SweepIndex readSweep(const fs::path& dir) {
   if (!fs::exists(index, ec)) throw InputError(dir.string() + " is not a sweep folder: no index.csv");
   SweepIndex sweep;
   sweep.dir = fs::absolute(dir).lexically_normal();
-  sweep.rows = parseIndexCsv(readText(index), index, sweep.dir);
+  sweep.rows = parseIndexCsv(readTextFile(index), index, sweep.dir);
   const fs::path manifest = dir / "trials.csv";
   if (fs::exists(manifest, ec)) {
-    const auto lines = csvLines(readText(manifest));
+    const auto lines = csvLines(readTextFile(manifest));
     checkHeader(lines, manifest, kManifestColumns);
     std::set<std::string> ids;
     for (std::size_t i = 1; i < lines.size(); ++i) ids.insert(splitFields(lines[i].second, ',').front());

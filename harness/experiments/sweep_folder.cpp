@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/experiments/report.h"
 #include "harness/io/staged_output.h"
 
@@ -23,13 +24,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-
-std::string readFile(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // The metrics index.csv takes (besides the trial's own fields), with whether they may be null.
 struct IndexColumn {
@@ -104,7 +98,9 @@ TrialFolder inspectTrialFolder(const SweepTrial& trial, const fs::path& folder) 
   }
   json j;
   try {
-    j = json::parse(readFile(metrics));
+    j = json::parse(readTextFile(metrics));
+  } catch (const InputError& e) {
+    return folderIn(TrialState::kCorrupt, "metrics.json cannot be read");
   } catch (const json::exception& e) {
     return folderIn(TrialState::kCorrupt, "metrics.json does not parse (" + std::string(e.what()) + ")");
   }
@@ -211,7 +207,7 @@ std::vector<SweepTrial> SweepDir::manifest() const {
   if (!fs::is_regular_file(file)) {
     throw InputError("--out: " + dir_.string() + " is not a sweep folder (no trials.csv)");
   }
-  return parseManifest(readFile(file), file.string());
+  return parseManifest(readTextFile(file), file.string());
 }
 
 std::vector<TrialFolder> SweepDir::inspect(const std::vector<SweepTrial>& trials) const {
@@ -238,7 +234,7 @@ void SweepDir::prepare(const Sweep& sweep) const {
   const fs::path commands = dir_ / "commands.txt";
   const std::string text = commandsText(sweep.trials);
   if (fs::exists(commands)) {
-    const std::string held = readFile(commands);
+    const std::string held = readTextFile(commands);
     if (held != text) {
       std::istringstream a(held), b(text);
       std::string la, lb;
@@ -252,7 +248,7 @@ void SweepDir::prepare(const Sweep& sweep) const {
   }
   makeOutputDir(dir_ / "trials");
   makeOutputDir(dir_ / "logs");
-  if (!fs::exists(dir_ / "sweep.yaml")) writeFileAtomic(dir_ / "sweep.yaml", readFile(sweep.source));
+  if (!fs::exists(dir_ / "sweep.yaml")) writeFileAtomic(dir_ / "sweep.yaml", readTextFile(sweep.source));
   writeFileAtomic(dir_ / "trials.csv", manifestCsv(sweep.trials));
   writeFileAtomic(commands, text);
 }

@@ -16,6 +16,7 @@
 #include <tuple>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/config/yaml_util.h"
 #include "harness/io/staged_output.h"
 
@@ -33,14 +34,6 @@ std::string stamp(double t_s) {
 
 std::string listHeader(const std::string& what) {
   return "# " + what + "\n# file: 'tgnav fly --record'\n# timestamp filename\n";
-}
-
-std::string readText(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot open file");
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(file.string() + ": cannot read file");
-  return text;
 }
 
 bool isCommentOrBlank(const std::string& line) {
@@ -61,7 +54,7 @@ std::vector<ListEntry> readList(const fs::path& dir, const std::string& name) {
     throw InputError(file.string() +
                      ": missing (a TUM RGB-D sequence folder holds rgb.txt, depth.txt, rgb/ and depth/)");
   }
-  std::istringstream in(readText(file));
+  std::istringstream in(readTextFile(file));
   std::vector<ListEntry> entries;
   std::string line;
   int line_no = 0;
@@ -139,7 +132,7 @@ std::string normaliseQuaternions(const std::string& text) {
 }
 
 std::vector<vo::StampedPose> readGroundtruth(const fs::path& file) {
-  const std::string text = readText(file);
+  const std::string text = readTextFile(file);
   std::vector<vo::StampedPose> poses;
   try {
     poses = vo::parseTum(normaliseQuaternions(text));
