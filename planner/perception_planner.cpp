@@ -183,6 +183,10 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
       plan.chosen = static_cast<int>(i);
     }
   }
+  if (request.homology_class >= 0) {
+    const auto k = static_cast<std::size_t>(request.homology_class);
+    plan.chosen = k < n && plan.candidates[k].feasible ? request.homology_class : -1;
+  }
   if (plan.chosen < 0) {
     plan.status = PlanStatus::kNoPath;
     return plan;
@@ -203,6 +207,14 @@ Plan AgnosticPlanner::solve(const PlanRequest& request) const {
     plan.candidates[i].path = headingPath(lift(plan.topo.classes[i].path, plan.flight_height_m), request.start.yaw_rad);
   }
   plan.chosen = plan.topo.chosen;
+  if (request.homology_class >= 0) {
+    if (request.homology_class >= static_cast<int>(plan.candidates.size())) {
+      plan.chosen = -1;
+      plan.status = PlanStatus::kNoPath;
+      return plan;
+    }
+    plan.chosen = request.homology_class;
+  }
   plan.path = plan.candidates[static_cast<std::size_t>(plan.chosen)].path;
   plan.chosen_class = plan.chosen;
   return plan;

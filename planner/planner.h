@@ -53,6 +53,11 @@ struct PlanRequest {
   Pose4 start;  // its z is the flight height: that of the GVD slice and of RRT*'s plane; the goal's z is ignored
   Pose4 goal;
   std::uint64_t seed = 0;  // the plan depends on it alone: the same seed gives the same plan
+  // The oracle (which classes can the VO fly?): >= 0 makes the proposed and agnostic planners fly
+  // this class of Plan::topo.classes instead of choosing one (proposed: its pose-graph path;
+  // agnostic: its shortest path), with every class still scored; no such class, or no 4-DoF path
+  // in it, is kNoPath. RRT* has no classes to choose from and refuses it (std::invalid_argument).
+  int homology_class = -1;
 };
 
 struct Plan {

@@ -20,6 +20,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <unordered_map>
 #include <vector>
 
@@ -307,6 +308,10 @@ PerceptionRrtStar::PerceptionRrtStar(const VoxelMap& voxels, const RrtStarConfig
 }
 
 Plan PerceptionRrtStar::solve(const PlanRequest& request) const {
+  if (request.homology_class >= 0) {
+    throw std::invalid_argument("PerceptionRrtStar: RRT* has no homology class to fly (homology_class = " +
+                                std::to_string(request.homology_class) + ")");
+  }
   Plan plan = searchTree(request.start, request.goal, request.seed);
   // The classes after the search, which never sees them: the tree and its path are the same as
   // without the labelling.

@@ -2,6 +2,7 @@
 // topological planning on a 2D occupancy grid (--grid: ROS map_server or MovingAI)
 // (harness/run/plan_job.h).
 #include <cstdio>
+#include <optional>
 
 #include "harness/base/errors.h"
 #include "harness/cli/cli.h"
@@ -27,10 +28,12 @@ struct PlanOptions {
   double robot_radius_m = 0.3;
   int max_classes = 10;
   std::string figure_format = "png";
+  std::optional<int> homology_class;
 };
 
 harness::PlanJobResult planGrid(const PlanOptions& opt) {
   if (opt.start.empty() || opt.goal.empty()) throw InputError("--grid needs --start X,Y and --goal X,Y");
+  if (opt.homology_class) throw InputError("--class: only with --scenario (the oracle of a scene's planners)");
   if (!opt.planner.empty() && opt.planner != "agnostic") {
     throw InputError("--planner: '" + opt.planner + "' needs a scene's feature map; with --grid only 'agnostic' runs");
   }
@@ -56,6 +59,7 @@ harness::PlanJobResult planScenario(const PlanOptions& opt) {
   job.map_cache = opt.map_cache;
   job.out = opt.out;
   job.figure_format = harness::parseFigureFormat(opt.figure_format);
+  job.homology_class = opt.homology_class;
   return harness::runScenarioPlan(job);
 }
 
@@ -86,7 +90,10 @@ void addPlanCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output directory")->required();
   cmd->add_option("--figure-format", opt->figure_format, "png | pdf | svg")->capture_default_str();
-  cmd->callback([opt] {
+  auto homology_class = std::make_shared<int>(0);
+  cmd->add_option("--class", *homology_class, "The oracle: plan homology class K (proposed or agnostic)");
+  cmd->callback([opt, cmd, homology_class] {
+    if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
     if (opt->scenario.empty() == opt->grid.empty()) throw InputError("plan: give one of --scenario FILE or --grid MAP");
     const harness::PlanJobResult r = opt->grid.empty() ? planScenario(*opt) : planGrid(*opt);
     harness::reportFigures("tgnav plan", r.figures);

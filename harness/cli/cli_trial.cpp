@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <optional>
 
 #include "harness/base/errors.h"
 #include "harness/cli/cli.h"
@@ -31,6 +32,7 @@ struct TrialCliOptions {
   long long seed = -1;  // -1: the scenario's
   std::string figure_format = "png";
   bool no_figures = false;
+  std::optional<int> homology_class;
 };
 
 // Percent of the path, sim time and real-time factor on a terminal, four times a second.
@@ -54,6 +56,7 @@ int runTrialCommand(TrialCliOptions& opt) {
   if (opt.seed >= 0) job.seed = static_cast<std::uint64_t>(opt.seed);
   job.figure_format = harness::parseFigureFormat(opt.figure_format);
   job.figures = !opt.no_figures;
+  job.homology_class = opt.homology_class;
   const harness::ProgressFn progress = terminalProgress();
   job.trial_starting = [] {
     g_interrupted.store(false);
@@ -99,9 +102,14 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_option("--map", job.map, "Feature map folder from `tgnav map` (default: cached by content)");
   cmd->add_option("--map-cache", job.map_cache,
                   "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
+  auto homology_class = std::make_shared<int>(0);
+  cmd->add_option("--class", *homology_class,
+                  "The oracle: fly homology class K of plan.json's classes (proposed: its pose-graph path; "
+                  "agnostic: its shortest path); not with rrtstar");
   cmd->add_option("--figure-format", opt->figure_format, "png | pdf | svg")->capture_default_str();
   cmd->add_flag("--no-figures", opt->no_figures, "Write the data only (a sweep's report draws the figures)");
-  cmd->callback([opt] {
+  cmd->callback([opt, cmd, homology_class] {
+    if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
     const int rc = runTrialCommand(*opt);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });

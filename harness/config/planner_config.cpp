@@ -1,5 +1,7 @@
 #include "harness/config/planner_config.h"
 
+#include "harness/config/check.h"
+
 namespace tgnav::harness {
 
 const std::vector<std::string>& PlannerSettings::sharedKeys() {
@@ -26,6 +28,7 @@ void PlannerSettings::validate() const {
   perception.validate();
   rrt_star.validate();
   trajectory.validate();
+  require(oracle_class >= -1, "oracle_class", oracle_class, "must be -1 (the planner chooses) or a class index >= 0");
 }
 
 }  // namespace tgnav::harness

@@ -17,6 +17,9 @@ struct PlannerSettings {
                                                 // labelling classes follow `perception`'s (one
                                                 // robot, one sensor, one set of classes)
   planner::TrajectoryConfig trajectory;         // its robot radius is perception's too
+  // The oracle: >= 0 makes proposed and agnostic fly this homology class (an index into plan.json's
+  // classes) instead of choosing one (planner::PlanRequest::homology_class); -1: they choose.
+  int oracle_class = -1;
 
   // The dotted keys of the fields that follow perception's: they have no keys of their own in
   // planner.yaml, and shareFromPerception() sets them.
@@ -31,6 +34,7 @@ struct PlannerSettings {
     perception.visit(s);
     s("rrt_star", rrt_star);
     s("trajectory", trajectory);
+    s("oracle_class", oracle_class);
     shareFromPerception();
   }
   // Copies perception's robot radius, visibility, information, slice and topology settings into

@@ -126,10 +126,12 @@ std::string scenarioSummary(const ScenarioPlanJob& job, const PlanRun& run, cons
 }  // namespace
 
 PlanJobResult runScenarioPlan(const ScenarioPlanJob& job) {
-  const Scenario scenario = loadScenario(job.scenario);
+  Scenario scenario = loadScenario(job.scenario);
+  if (job.homology_class) applyOracleClass(*job.homology_class, job.planner, &scenario);
   const std::uint64_t seed = job.seed.value_or(scenario.seed);
   const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav plan");
-  const PlanRun run = runPlanner(scenario, map, job.planner, seed, job.samples);
+  const PlanRun run = runPlanner(scenario, map, job.planner, seed, job.samples,
+                                 job.homology_class ? "--class" : "planner.oracle_class");
 
   StagedDir staged(job.out);
   const std::filesystem::path& dir = staged.staging();

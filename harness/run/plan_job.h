@@ -24,6 +24,7 @@ struct ScenarioPlanJob {
   std::string map_cache;
   std::filesystem::path out;
   FigureFormat figure_format = FigureFormat::kPng;
+  std::optional<int> homology_class;  // the oracle: fly this class (planner.oracle_class)
 };
 
 struct GridPlanJob {

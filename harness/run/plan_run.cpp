@@ -71,8 +71,16 @@ planner::PlannerKind parsePlannerName(const std::string& text, const std::string
   return kind;
 }
 
+void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario) {
+  if (k < 0) throw InputError("--class: " + std::to_string(k) + " must be >= 0");
+  if (planner == planner::PlannerKind::kRrtStar) {
+    throw InputError("--class: the rrtstar planner has no homology class to fly; use proposed or agnostic");
+  }
+  scenario->planner.oracle_class = k;
+}
+
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
-                   std::uint64_t seed, int rrt_samples) {
+                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option) {
   PlanRun run;
   run.planner = kind;
   run.seed = seed;
@@ -96,10 +104,23 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
       throw InputError(std::string("--samples: ") + e.what());
     }
   }
+  const int oracle = scenario.planner.oracle_class;
+  if (oracle >= 0 && kind == planner::PlannerKind::kRrtStar) {
+    throw InputError(oracle_option + " = " + std::to_string(oracle) +
+                     ": the rrtstar planner has no homology class to fly; use proposed or agnostic");
+  }
   const auto solver = planner::makePlanner(kind, *run.voxels, scenario.planner.perception, rrt);
+  planner::PlanRequest request{scene.start, scene.goal, seed};
+  request.homology_class = oracle;
   t0 = std::chrono::steady_clock::now();
-  run.plan = solver->solve(planner::PlanRequest{scene.start, scene.goal, seed});
+  run.plan = solver->solve(request);
   run.solve_s = since(t0);
+  const auto classes = static_cast<int>(run.plan.topo.classes.size());
+  if (oracle >= classes && run.plan.topo.status == planner::PlanStatus::kSolved) {
+    throw InputError(oracle_option + " = " + std::to_string(oracle) +
+                     ": out of range: " + scenario.scene.source.stem().string() + " has " + std::to_string(classes) +
+                     " homology classes (0.." + std::to_string(classes - 1) + ")");
+  }
   makeTrajectory(scenario, &run);
   return run;
 }
@@ -120,6 +141,8 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   j["goal"] = {g.p_WB.x(), g.p_WB.y(), g.p_WB.z(), g.yaw_rad};
   j["flight_height_m"] = run.plan.flight_height_m;
   j["c_p_threshold"] = scenario.planner.perception.selection.c_p_threshold;
+  j["oracle_class"] =
+      scenario.planner.oracle_class >= 0 ? nlohmann::json(scenario.planner.oracle_class) : nlohmann::json(nullptr);
   j["timing"] = {{"voxel_map_s", run.voxel_map_s}, {"solve_s", run.solve_s}, {"trajectory_s", run.trajectory_s}};
   j["topology_classes"] = run.plan.topo.classes.size();
   j["classes"] = nlohmann::json::array();

@@ -35,8 +35,14 @@ struct PlanRun {
 
 // Box of the dense voxel map: the scene's bounds widened by `margin_m` (walls lie just outside
 // the free-space bounds and must be inside the box to be seen and avoided).
+// `--class K`: sets scenario->planner.oracle_class; InputError for K < 0 or with RRT*, which has
+// no homology classes to fly.
+void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario);
+
+// An oracle class (scenario.planner.oracle_class) with RRT*, or beyond the classes found, is an
+// InputError naming `oracle_option`.
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind name,
-                   std::uint64_t seed, int rrt_samples);
+                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class");
 
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
 // The generated trajectory sampled at the configured rate, as the controller takes it (and

@@ -282,7 +282,7 @@ class ClosedLoop {
 TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
                      const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   TrialResult result;
-  result.plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples);
+  result.plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples, options.oracle_option);
   const planner::Plan& plan = result.plan.plan;
   if (plan.chosen < 0 || !result.plan.trajectory.trajectory) {
     result.status = TrialStatus::kPlanFailed;

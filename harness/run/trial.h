@@ -33,7 +33,8 @@ struct TrialOptions {
   planner::PlannerKind planner = planner::PlannerKind::kProposed;
   int rrt_samples = 0;  // 0: the planner config's
   std::uint64_t seed = 0;
-  int strip_frames = 0;  // > 0: keep this many frames, evenly spread, for a frame strip
+  int strip_frames = 0;                                // > 0: keep this many frames, evenly spread, for a frame strip
+  std::string oracle_option = "planner.oracle_class";  // names the oracle class in errors
 };
 
 struct TrialProgress {

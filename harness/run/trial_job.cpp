@@ -87,7 +87,9 @@ std::string configYaml(const Scenario& scenario, const TrialOptions& options, co
   std::ostringstream config;
   config << "# tgnav trial --planner " << planner::toString(options.planner);
   if (options.planner == planner::PlannerKind::kRrtStar) config << " --samples " << r.plan.rrt_samples;
-  config << " --seed " << options.seed << "\n" << resolvedScenarioYaml(scenario);
+  config << " --seed " << options.seed;
+  if (scenario.planner.oracle_class >= 0) config << " --class " << scenario.planner.oracle_class;
+  config << "\n" << resolvedScenarioYaml(scenario);
   return config.str();
 }
 
@@ -137,7 +139,11 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   Scenario scenario = loadScenario(job.scenario, &overrides);
   if (job.seed) scenario.seed = *job.seed;
   if (job.threads > 0) limitThreads(job.threads, &scenario);
-  const TrialOptions options{job.planner, job.samples, scenario.seed, job.frames};
+  TrialOptions options{job.planner, job.samples, scenario.seed, job.frames};
+  if (job.homology_class) {
+    applyOracleClass(*job.homology_class, job.planner, &scenario);
+    options.oracle_option = "--class";
+  }
   checkOutput(job.out, job.force);
   StagedDir staged(job.out);
   const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial");

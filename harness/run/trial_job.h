@@ -28,8 +28,9 @@ struct TrialJob {
   int frames = 0;      // frames.png with this many onboard frames (0-64)
   std::string map;     // feature map folder; "" = the cache
   std::string map_cache;
-  int threads = 0;      // > 0: at most this many threads (results do not change)
-  bool figures = true;  // draw topdown and ate (a sweep leaves them to its report)
+  int threads = 0;                    // > 0: at most this many threads (results do not change)
+  std::optional<int> homology_class;  // the oracle: fly this class (planner.oracle_class)
+  bool figures = true;                // draw topdown and ate (a sweep leaves them to its report)
   FigureFormat figure_format = FigureFormat::kPng;
   // Called right before the trial (planning and flight) and right after it, before the results
   // are written: the CLI catches Ctrl-C only in between (a signal while the map is built or the

@@ -74,6 +74,8 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["samples"] =
       options.planner == planner::PlannerKind::kRrtStar ? ordered_json(result.plan.rrt_samples) : ordered_json(nullptr);
   j["seed"] = options.seed;
+  j["oracle_class"] =
+      scenario.planner.oracle_class >= 0 ? ordered_json(scenario.planner.oracle_class) : ordered_json(nullptr);
   j["state_source"] = toString(scenario.trial.state_source);
   j["status"] = toString(result.status);
   j["detail"] = result.detail;

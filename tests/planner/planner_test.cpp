@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -131,6 +132,52 @@ TEST(Planner, EachPlannerReturnsAClearPathFromStartToGoalAndTheClassItIsIn) {
                 << chosen.length_m << " m, c_p,min " << chosen.c_p_min << "\n";
     }
   }
+}
+
+// The oracle: asked for class K, proposed and AP fly class K (its path lies in K, whatever they
+// would have chosen), still scoring every class; no class K is no path; RRT* refuses the request.
+TEST(Planner, TheOracleFliesTheRequestedClass) {
+  const TwoPillars& w = twoPillars();
+  const PerceptionPlannerConfig perception;
+  const RrtStarConfig rrt_star;
+  for (PlannerKind kind : {PlannerKind::kProposed, PlannerKind::kAgnostic}) {
+    const std::unique_ptr<Planner> planner = makePlanner(kind, w.voxels, perception, rrt_star);
+    const Plan own = planner->solve({w.start, w.goal, 1});
+    ASSERT_EQ(own.topo.classes.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      PlanRequest request{w.start, w.goal, 1};
+      request.homology_class = k;
+      const Plan forced = planner->solve(request);
+      const std::string what = std::string(planner->name()) + " class " + std::to_string(k);
+      ASSERT_EQ(forced.status, PlanStatus::kSolved) << what;
+      EXPECT_EQ(forced.chosen, k) << what;
+      EXPECT_EQ(forced.chosen_class, k) << what;
+      std::vector<Eigen::Vector2d> xy;
+      for (const Pose4& p : forced.path) xy.push_back(p.p_WB.head<2>());
+      EXPECT_TRUE(TopologicalPlanner::sameClass(windingAngles(xy, forced.topo.obstacle_points),
+                                                forced.topo.classes[static_cast<std::size_t>(k)].h_signature))
+          << what;
+      ASSERT_EQ(forced.candidates.size(), own.candidates.size()) << what;
+      for (std::size_t i = 0; i < own.candidates.size(); ++i) {  // every class scored as without the oracle
+        EXPECT_EQ(forced.candidates[i].length_m, own.candidates[i].length_m) << what;
+        const double a = forced.candidates[i].cost, b = own.candidates[i].cost;
+        EXPECT_TRUE(a == b || (std::isnan(a) && std::isnan(b))) << what << ": " << a << " vs " << b;
+      }
+      if (k == own.chosen) {
+        EXPECT_EQ(forced.path.size(), own.path.size()) << what;
+      }
+    }
+    PlanRequest missing{w.start, w.goal, 1};
+    missing.homology_class = 4;
+    const Plan none = planner->solve(missing);
+    EXPECT_EQ(none.status, PlanStatus::kNoPath) << planner->name();
+    EXPECT_EQ(none.chosen, -1) << planner->name();
+    EXPECT_TRUE(none.path.empty()) << planner->name();
+  }
+  PlanRequest rrt_request{w.start, w.goal, 1};
+  rrt_request.homology_class = 0;
+  EXPECT_THROW(makePlanner(PlannerKind::kRrtStar, w.voxels, perception, rrt_star)->solve(rrt_request),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -224,6 +224,37 @@ TEST(SmokeTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
+// The oracle (--class K) flies class K instead of the planner's choice; a class that does not
+// exist, a negative one or one asked of RRT* is bad input: one line, exit 2, nothing written.
+TEST(SmokeTrialCli, OracleClassIsCheckedAndRecorded) {
+  const auto dir = tempDir();
+  const auto out = dir / "trial";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--class -1", "--class: -1 must be >= 0"},
+      {"--planner rrtstar --class 0", "--class: the rrtstar planner has no homology class"},
+      {"--class 9", "--class = 9: out of range: smoke has 2 homology classes (0..1)"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const CmdResult run = shell(trialCommand(args + " --out " + out.string()));
+    EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
+    EXPECT_EQ(lines(run.output), 1) << args << "\n" << run.output;
+    EXPECT_NE(run.output.find(expected), std::string::npos) << args << "\n" << run.output;
+    EXPECT_TRUE(std::filesystem::is_empty(dir)) << args;
+  }
+  // The shortest class is AP's own choice; asked for the other, it plans that one.
+  for (int k : {-1, 0, 1}) {
+    const auto plan_dir = dir / ("plan" + std::to_string(k));
+    const std::string oracle = k >= 0 ? " --class " + std::to_string(k) : "";
+    const CmdResult run = shell(std::string(TGNAV_BIN) + " plan --scenario " + kScenario + " --map-cache " +
+                                TGNAV_TEST_CACHE + " --planner agnostic" + oracle + " --out " + plan_dir.string());
+    ASSERT_EQ(run.rc, 0) << run.output;
+    const nlohmann::json plan = nlohmann::json::parse(readText(plan_dir / "plan.json"));
+    ASSERT_EQ(plan["classes"].size(), 2u) << run.output;
+    EXPECT_EQ(plan["chosen_topology_class"], k >= 0 ? k : 0) << oracle;
+    EXPECT_EQ(plan["oracle_class"], k >= 0 ? nlohmann::json(k) : nlohmann::json(nullptr)) << oracle;
+  }
+}
+
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
   const auto out = tempDir() / "trial";
   // A long final hold keeps the vehicle flying when the signal comes.
