@@ -166,10 +166,11 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   if (r.status == TrialStatus::kInterrupted) {
     writeFileAtomic(d / "INCOMPLETE", "interrupted: " + r.detail + "; these results are partial\n");
   } else {
-    // Last: a folder with metrics.json is a finished trial.
+    // A folder with metrics.json is a finished trial (the folder appears whole when committed).
     writeFileAtomic(d / "metrics.json", trialMetricsJson(scenario, options, r, scores, timing).dump(2) + "\n");
-    if (job.figures) result.figures = drawFigures("trial", d, job.figure_format);
   }
+  // Partial results get their figures too; they read metrics.json where there is one.
+  if (job.figures) result.figures = drawFigures("trial", d, job.figure_format);
   staged.commit(OnExisting::kReplace);
   result.out = staged.target();
   result.status = r.status;
