@@ -12,4 +12,12 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A message on one line: trailing newlines and spaces dropped, inner newlines become "; " (library
+// and tool messages may span several).
+inline std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) text.replace(i, 1, "; ");
+  return text;
+}
+
 }  // namespace tgnav

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "harness/base/errors.h"
 #include "harness/config/values.h"
 
 namespace tgnav::cli {
@@ -20,9 +21,5 @@ void addMapCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addTrialCommand(CLI::App& app);
 void addVoCommand(CLI::App& app);
-
-// An error message on one line: trailing newlines dropped, inner ones become "; " (library and
-// tool messages may span several).
-std::string oneLine(std::string text);
 
 }  // namespace tgnav::cli

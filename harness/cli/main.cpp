@@ -7,18 +7,6 @@
 #include "harness/base/errors.h"
 #include "harness/cli/cli.h"
 
-namespace tgnav::cli {
-
-std::string oneLine(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) {
-    text.replace(i, 1, "; ");
-  }
-  return text;
-}
-
-}  // namespace tgnav::cli
-
 int main(int argc, char** argv) {
   CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
   app.require_subcommand(1);
@@ -42,10 +30,10 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   } catch (const tgnav::InputError& e) {
-    std::fprintf(stderr, "tgnav: error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
+    std::fprintf(stderr, "tgnav: error: %s\n", tgnav::oneLine(e.what()).c_str());
     return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "tgnav: internal error: %s\n", tgnav::cli::oneLine(e.what()).c_str());
+    std::fprintf(stderr, "tgnav: internal error: %s\n", tgnav::oneLine(e.what()).c_str());
     return 1;
   }
   return 0;

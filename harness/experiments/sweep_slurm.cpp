@@ -17,13 +17,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A tool's output on one line, for a message: trailing newlines dropped, inner ones "; ".
-std::string oneLine(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
-  for (std::size_t i = text.find('\n'); i != std::string::npos; i = text.find('\n', i)) text.replace(i, 1, "; ");
-  return text;
-}
-
 // The job name of the sweep's arrays: unique to its folder, so squeue finds them by name.
 std::string jobName(const SweepDir& dir) {
   std::uint64_t h = 1469598103934665603ULL;  // FNV-1a

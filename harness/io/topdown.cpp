@@ -74,6 +74,12 @@ MapLayer Topdown::layer(const std::string& title) const {
   return l;
 }
 
+MapLayer sceneMapLayer(const SceneConfig& scene, const planner::FeatureMap& map, double band_m, double pixels_across) {
+  Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / pixels_across);
+  topdown.drawMap(map, band_m);
+  return topdown.layer(scene.source.stem().string());
+}
+
 void writeMapLayer(const std::filesystem::path& dir, const MapLayer& layer) {
   auto xy = [](const std::optional<Eigen::Vector2d>& p) {
     return p ? nlohmann::json::array({p->x(), p->y()}) : nlohmann::json(nullptr);

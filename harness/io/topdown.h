@@ -25,6 +25,10 @@ struct MapLayer {
   // What the raster's colours mean (RGB, 0-255), for the figure's legend.
   std::vector<std::pair<std::string, cv::Vec3b>> legend;
 };
+// The feature map of `scene` in a band of +-band_m about its flight height, `pixels_across` wide,
+// titled with the scene's name: what the top-down figures of map, plan and trial lie on.
+MapLayer sceneMapLayer(const SceneConfig& scene, const planner::FeatureMap& map, double band_m,
+                       double pixels_across = 800.0);
 // Writes map.png and map.json into `dir`.
 void writeMapLayer(const std::filesystem::path& dir, const MapLayer& layer);
 

@@ -17,8 +17,6 @@ namespace fs = std::filesystem;
 
 // The map's height band drawn in the top-down raster, about the flight height.
 constexpr double kRasterBandM = 0.3;
-// Pixels across the raster, whatever the scene's size.
-constexpr double kRasterPixels = 800.0;
 
 nlohmann::ordered_json summaryJson(const SceneConfig& scene, const MapBuildConfig& c, const MapBuildStats& s) {
   nlohmann::ordered_json j;
@@ -76,9 +74,7 @@ MapRunResult runMap(const MapJob& job) {
     const QuietStderr quiet;
     map.save(staged.staging());
   }
-  Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / kRasterPixels);
-  topdown.drawMap(map, kRasterBandM);
-  writeMapLayer(staged.staging(), topdown.layer(scene.source.stem().string()));
+  writeMapLayer(staged.staging(), sceneMapLayer(scene, map, kRasterBandM));
   writeFileAtomic(staged.staging() / "summary.json", summaryJson(scene, config, result.stats).dump(2) + "\n");
   result.figures = drawFigures("map", staged.staging(), job.figure_format);
   staged.commit(OnExisting::kReplace);

@@ -140,10 +140,7 @@ PlanJobResult runScenarioPlan(const ScenarioPlanJob& job) {
     writeFileAtomic(dir / "trajectory.csv", trajectoryCsv(setpoints(run, scenario.planner.trajectory.sample_rate_hz)));
   }
   writeFileAtomic(dir / "plan.json", planJson(scenario, run).dump(2) + "\n");
-  const SceneConfig& scene = scenario.scene;
-  Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / kLayerPixels);
-  topdown.drawMap(map, scenario.planner.perception.slice_half_height_m);
-  writeMapLayer(dir, topdown.layer(scene.source.stem().string()));
+  writeMapLayer(dir, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   PlanJobResult result;
   result.figures = drawFigures("plan", dir, job.figure_format);
   staged.commit(OnExisting::kMerge);

@@ -22,9 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Pixels across the map layer of the figures.
-constexpr double kLayerPixels = 800.0;
-
 void checkJob(const TrialJob& job) {
   if (job.samples != 0 && job.planner != planner::PlannerKind::kRrtStar) {
     throw InputError("--samples: only the rrtstar planner takes a sample budget");
@@ -107,13 +104,6 @@ void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& 
   if (!r.strip.empty()) writeImageAtomic(d / "frames.png", drawFrameStrip(r.strip, r.strip_captions));
 }
 
-void writeMapLayerOf(const fs::path& d, const Scenario& scenario, const planner::FeatureMap& map) {
-  const SceneConfig& scene = scenario.scene;
-  Topdown topdown(scene, (scene.bounds_max_m.x() - scene.bounds_min_m.x()) / kLayerPixels);
-  topdown.drawMap(map, scenario.planner.perception.slice_half_height_m);
-  writeMapLayer(d, topdown.layer(scene.source.stem().string()));
-}
-
 std::string summaryLine(const Scenario& scenario, const TrialOptions& options, const TrialResult& r,
                         const TrialScores& scores, const TrialTiming& timing, const fs::path& out) {
   std::ostringstream line;
@@ -161,7 +151,7 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
 
   const fs::path& d = staged.staging();
   writeData(d, scenario, options, r);
-  writeMapLayerOf(d, scenario, map);
+  writeMapLayer(d, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   TrialJobResult result;
   if (r.status == TrialStatus::kInterrupted) {
     writeFileAtomic(d / "INCOMPLETE", "interrupted: " + r.detail + "; these results are partial\n");
