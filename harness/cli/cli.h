@@ -15,6 +15,7 @@ using harness::parseNumbers;
 void addDefaultsCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
+void addSceneCommand(CLI::App& app);
 void addSweepCommand(CLI::App& app);
 void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
