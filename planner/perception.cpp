@@ -10,6 +10,22 @@ namespace tgnav::planner {
 void InformationConfig::validate() const {
   require(bearing_noise_rad > 0.0, "bearing_noise_rad", bearing_noise_rad, "must be > 0");
   require(epsilon > 0.0, "information_epsilon", epsilon, "must be > 0");
+  require(max_incidence_rad > 0.0 && max_incidence_rad <= M_PI / 2.0, "max_incidence_rad", max_incidence_rad,
+          "must be in (0, pi/2]");
+  require(min_landmarks >= 0.0 && std::isfinite(min_landmarks), "min_landmarks", min_landmarks,
+          "must be finite and >= 0");
+}
+
+bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, const InformationConfig& config) {
+  if (config.max_incidence_rad >= M_PI / 2.0 || point.normal_W.isZero()) return true;
+  const Eigen::Vector3d to_camera = p_W - point.p_W;
+  const double range = to_camera.norm();
+  return range > 0.0 && point.normal_W.dot(to_camera) >= std::cos(config.max_incidence_rad) * range;
+}
+
+double scoreInformation(const Matrix6d& info, double landmarks, const InformationConfig& config) {
+  return landmarks < config.min_landmarks ? logDetInformation(Matrix6d::Zero(), config.epsilon)
+                                          : logDetInformation(info, config.epsilon);
 }
 
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
@@ -21,7 +37,8 @@ std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::v
   std::vector<WeightedPoint> points;
   points.reserve(count.size());
   for (const auto& [slot, n] : count) {
-    points.push_back({voxels.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W, static_cast<double>(n)});
+    const LandmarkVoxel& v = voxels.landmarkVoxels()[static_cast<std::size_t>(slot)];
+    points.push_back({v.mean_W, static_cast<double>(n), v.normal_W});
   }
   return points;
 }
@@ -38,19 +55,24 @@ bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vect
 }
 
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
-                         const VisibilityConfig& visibility, const InformationConfig& config) {
+                         const VisibilityConfig& visibility, const InformationConfig& config, double* landmarks) {
   Matrix6d info = Matrix6d::Zero();
+  double count = 0.0;
   for (const WeightedPoint& pt : points) {
-    if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility)) {
+    if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
+      count += pt.weight;
     }
   }
+  if (landmarks != nullptr) *landmarks = count;
   return info;
 }
 
 double poseScore(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                  const VisibilityConfig& visibility, const InformationConfig& config) {
-  return logDetInformation(poseInformation(p_W, yaw_rad, points, visibility, config), config.epsilon);
+  double landmarks = 0.0;
+  const Matrix6d info = poseInformation(p_W, yaw_rad, points, visibility, config, &landmarks);
+  return scoreInformation(info, landmarks, config);
 }
 
 }  // namespace tgnav::planner

@@ -9,6 +9,7 @@
 // count): they lie within one voxel (0.1 m) of each other, metres from the camera, so their
 // bearings and information agree to a fraction of a percent, and the sums get 10-20x cheaper.
 #include <Eigen/Core>
+#include <cmath>
 #include <vector>
 
 #include "planner/feature_map.h"
@@ -20,12 +21,22 @@ namespace tgnav::planner {
 struct InformationConfig {
   double bearing_noise_rad = 1.0;  // sigma of eq. 5; 1 puts c_p on the scale of Table I's c_p,thr = 6
   double epsilon = 1e-2;           // log det regulariser: a blind pose scores 6 ln(1e-2) = -27.6
+  // Trackability (ours; the paper counts every landmark in the FoV and range). A landmark counts
+  // only when the camera sees its surface within max_incidence_rad of the surface's normal (where
+  // the map knows the normal: LandmarkVoxel::normal_W): feature descriptors do not match across
+  // grazing views. A pose with fewer than min_landmarks landmarks that count scores as blind
+  // (6 ln epsilon): the VO is lost below its minimum of inliers, however informative a handful
+  // of landmarks would be in theory. Calibrated against the VO (README: the perception model).
+  double max_incidence_rad = M_PI / 2.0;  // pi/2: no limit
+  double min_landmarks = 0.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
   void visit(Archive& a) {
     a("bearing_noise_rad", bearing_noise_rad);
     a("epsilon", epsilon);
+    a("max_incidence_rad", max_incidence_rad);
+    a("min_landmarks", min_landmarks);
   }
 
   void validate() const;
@@ -33,8 +44,17 @@ struct InformationConfig {
 
 struct WeightedPoint {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
-  double weight = 1.0;  // number of landmarks at this point
+  double weight = 1.0;                                 // number of landmarks at this point
+  Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();  // their surface's outward normal; zero: unknown
 };
+
+// True when a camera at p_W sees `point`'s surface within config.max_incidence_rad of its normal
+// (always, where the normal is unknown).
+bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, const InformationConfig& config);
+
+// The score of a pose from its information and the weight of the landmarks behind it: log det
+// (I + eps Id), or the blind score 6 ln eps when fewer than config.min_landmarks count.
+double scoreInformation(const Matrix6d& info, double landmarks, const InformationConfig& config);
 
 // The candidate landmarks `ids` grouped by their voxel in `voxels`; ids outside its box are left out.
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids);
@@ -43,10 +63,12 @@ std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::v
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility);
 
-// Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose.
+// Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose that
+// are within the incidence limit; `landmarks` (optional): their summed weight.
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
-                         const VisibilityConfig& visibility, const InformationConfig& config);
-// log det of poseInformation() + epsilon I: the pose's term of eq. 8.
+                         const VisibilityConfig& visibility, const InformationConfig& config,
+                         double* landmarks = nullptr);
+// scoreInformation() of poseInformation(): log det (I + epsilon Id), the pose's term of eq. 8.
 double poseScore(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                  const VisibilityConfig& visibility, const InformationConfig& config);
 

@@ -111,6 +111,8 @@ void SelectionConfig::validate() const {
   require(std::isfinite(c_p_threshold), "c_p_threshold", c_p_threshold, "must be finite");
   require(distance_weight >= 0.0, "selection.distance_weight", distance_weight, "must be >= 0");
   require(perception_weight >= 0.0, "selection.perception_weight", perception_weight, "must be >= 0");
+  require(perception_tolerance >= 0.0 && std::isfinite(perception_tolerance), "selection.perception_tolerance",
+          perception_tolerance, "must be finite and >= 0");
 }
 
 void PerceptionPlannerConfig::validate() const {
@@ -129,6 +131,26 @@ double selectionCost(double length_m, double shortest_m, double c_p_min, const S
   const double extra = shortest_m > 0.0 ? length_m / shortest_m - 1.0 : 0.0;
   const double f = 1.0 / (1.0 + std::exp(c_p_min - config.c_p_threshold));
   return config.distance_weight * extra + config.perception_weight * f;
+}
+
+int selectCandidate(std::vector<CandidatePath>& candidates, const SelectionConfig& config) {
+  double shortest = std::numeric_limits<double>::infinity();
+  double best_c_p_min = -std::numeric_limits<double>::infinity();
+  for (const CandidatePath& c : candidates) {
+    if (!c.feasible) continue;
+    shortest = std::min(shortest, c.length_m);
+    best_c_p_min = std::max(best_c_p_min, c.c_p_min);
+  }
+  const bool perception_first = config.perception_first && best_c_p_min < config.c_p_threshold;
+  int chosen = -1;
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    CandidatePath& c = candidates[i];
+    if (!c.feasible) continue;
+    c.cost = selectionCost(c.length_m, shortest, c.c_p_min, config);
+    if (perception_first && c.c_p_min < best_c_p_min - config.perception_tolerance) continue;
+    if (chosen < 0 || c.cost < candidates[static_cast<std::size_t>(chosen)].cost) chosen = static_cast<int>(i);
+  }
+  return chosen;
 }
 
 ProposedPlanner::ProposedPlanner(const VoxelMap& voxels, const PerceptionPlannerConfig& config)
@@ -171,18 +193,7 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
         tbb::simple_partitioner());
   });
 
-  double shortest = std::numeric_limits<double>::infinity();
-  for (const CandidatePath& c : plan.candidates) {
-    if (c.feasible) shortest = std::min(shortest, c.length_m);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    CandidatePath& c = plan.candidates[i];
-    if (!c.feasible) continue;
-    c.cost = selectionCost(c.length_m, shortest, c.c_p_min, config_.selection);
-    if (plan.chosen < 0 || c.cost < plan.candidates[static_cast<std::size_t>(plan.chosen)].cost) {
-      plan.chosen = static_cast<int>(i);
-    }
-  }
+  plan.chosen = selectCandidate(plan.candidates, config_.selection);
   if (request.homology_class >= 0) {
     const auto k = static_cast<std::size_t>(request.homology_class);
     plan.chosen = k < n && plan.candidates[k].feasible ? request.homology_class : -1;

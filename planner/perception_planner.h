@@ -15,6 +15,14 @@
 // a class pays up to eta_p when its weakest segment falls below c_p,thr, and eta_d per unit of
 // relative extra length. With Table I (eta_d 0.2, eta_p 1.5) a fully feature-poor class loses
 // to a feature-rich one up to 1 + 1.5/0.2 = 8.5 times its length.
+//
+// Below the threshold (ours, SelectionConfig::perception_first): f saturates, so when no class's
+// c_p,min reaches c_p,thr, a class blind somewhere (c_p,min = 6 ln eps = -27.6) and a class with
+// weak but real information everywhere (c_p,min = 0.5) both pay ~eta_p and eq. 9 falls back to the
+// shortest, blind segment included; on a scene from outside the repository that lost the VO in
+// 4 of 5 trials. In that regime we rank by perception first: the classes whose c_p,min is within
+// perception_tolerance of the best one compete by eq. 9, the others are out. With some class at or
+// above c_p,thr, eq. 9 decides alone, as in the paper.
 #include "planner/covisibility.h"
 #include "planner/perception.h"
 #include "planner/planner.h"
@@ -25,9 +33,11 @@
 namespace tgnav::planner {
 
 struct SelectionConfig {
-  double c_p_threshold = 6.0;      // c_p,thr (Table I)
-  double distance_weight = 0.2;    // eta_d
-  double perception_weight = 1.5;  // eta_p
+  double c_p_threshold = 6.0;         // c_p,thr (Table I)
+  double distance_weight = 0.2;       // eta_d
+  double perception_weight = 1.5;     // eta_p
+  bool perception_first = true;       // below c_p,thr: rank by c_p,min first (ours, see above)
+  double perception_tolerance = 1.0;  // c_p,min this close to the best counts as equal there
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -35,6 +45,8 @@ struct SelectionConfig {
     a("c_p_threshold", c_p_threshold);
     a("distance_weight", distance_weight);
     a("perception_weight", perception_weight);
+    a("perception_first", perception_first);
+    a("perception_tolerance", perception_tolerance);
   }
 
   void validate() const;
@@ -74,6 +86,11 @@ struct PerceptionPlannerConfig {
 
 // Eq. 9 with the intended sign (see above). The smallest wins.
 double selectionCost(double length_m, double shortest_m, double c_p_min, const SelectionConfig& config);
+
+// Sets every feasible candidate's eq. 9 cost and returns the index of the chosen one (-1: none
+// feasible): the cheapest, among the classes still in the running (all of them, unless no class
+// reaches c_p,thr and perception_first holds; see above). Ties go to the lower index.
+int selectCandidate(std::vector<CandidatePath>& candidates, const SelectionConfig& config);
 
 // Alg. 1. Candidates: every class's best 4-DoF path (infeasible where the pose graph finds none),
 // with its eq. 9 cost; the cheapest is chosen. details: per class. chosen_class = chosen.

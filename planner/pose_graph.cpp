@@ -10,6 +10,7 @@ namespace tgnav::planner {
 
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+const double kGoldenAngle = M_PI * (3.0 - std::sqrt(5.0));  // 137.5 deg
 
 // Angle in [-pi, pi] for arguments within a few turns (cheaper than std::remainder).
 double wrapAngle(double a) {
@@ -129,9 +130,17 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       Eigen::Vector3d e1, e2;
       const Eigen::Vector3d tangent = pointAt(path, s + 0.05) - pointAt(path, s - 0.05);
       perpendicularBasis(tangent.norm() > 1e-9 ? tangent : Eigen::Vector3d::UnitX(), &e1, &e2);
-      for (int k = 1; k < config.position_samples; ++k) {
-        const double r = config.sample_radius_m * std::sqrt(unit(rng));
-        const double a = 2.0 * M_PI * unit(rng);
+      const int others = config.position_samples - 1;
+      for (int k = 1; k <= others; ++k) {
+        double r = 0.0;
+        double a = 0.0;
+        if (config.random_positions) {
+          r = config.sample_radius_m * std::sqrt(unit(rng));
+          a = 2.0 * M_PI * unit(rng);
+        } else {  // sunflower lattice: equal areas per point, the outermost on the rim
+          r = config.sample_radius_m * std::sqrt((k - 0.5) / (others - 0.5));
+          a = kGoldenAngle * (k + j);
+        }
         candidates.push_back(centre + r * (std::cos(a) * e1 + std::sin(a) * e2));
       }
     }
@@ -149,10 +158,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       layer_positions.push_back(p);
       // Information per yaw: each landmark adds to the yaws whose horizontal FoV holds it.
       std::vector<Matrix6d> info(static_cast<std::size_t>(yaws), Matrix6d::Zero());
+      std::vector<double> count(static_cast<std::size_t>(yaws), 0.0);
       for (const WeightedPoint& pt : points) {
         const Eigen::Vector3d d = pt.p_W - p;
         const double range = d.norm();
         if (range < visibility.min_range_m || range > visibility.max_range_m) continue;
+        if (!withinIncidence(p, pt, information)) continue;
         if (std::atan2(std::abs(d.z()), d.head<2>().norm()) > 0.5 * visibility.vfov_rad) continue;
         const double azimuth = std::atan2(d.y(), d.x());
         Matrix6d contribution = Matrix6d::Zero();
@@ -167,11 +178,13 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
           const int idx = ((k % yaws) + yaws) % yaws;
           if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
             info[static_cast<std::size_t>(idx)] += contribution;
+            count[static_cast<std::size_t>(idx)] += pt.weight;
           }
         }
       }
       for (int k = 0; k < yaws; ++k) {
-        const double score = logDetInformation(info[static_cast<std::size_t>(k)], information.epsilon);
+        const double score =
+            scoreInformation(info[static_cast<std::size_t>(k)], count[static_cast<std::size_t>(k)], information);
         const bool allowed = !(j == 0 && !std::isnan(start_yaw_rad) && k != 0);
         layer_scores.push_back(score);
         layer_cost.push_back(allowed ? -config.perception_weight * score / layers : kInf);

@@ -187,6 +187,7 @@ class CovisibilityScorer {
     const std::vector<LandmarkVoxel>& all = voxels_.landmarkVoxels();
     for (std::size_t slot = 0; slot < all.size(); ++slot) {
       if (!inFieldOfView(p, s->getYaw(), all[slot].mean_W, vis)) continue;
+      if (!withinIncidence(p, {all[slot].mean_W, 1.0, all[slot].normal_W}, config_.information)) continue;
       const Eigen::Vector3d d = all[slot].centre_W - p;
       const double r = d.norm();
       if (r < vis.min_range_m || r > vis.max_range_m || std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
@@ -202,6 +203,7 @@ class CovisibilityScorer {
     const View& b = view(s2);
     const Eigen::Vector3d p2 = position(s2, z_);
     Matrix6d info = Matrix6d::Zero();
+    double landmarks = 0.0;
     std::size_t i = 0;
     std::size_t j = 0;
     while (i < a.slots.size() && j < b.slots.size()) {
@@ -213,11 +215,12 @@ class CovisibilityScorer {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
         addCentredInformation(p2, l.mean_W, static_cast<double>(l.ids.size()), config_.information.bearing_noise_rad,
                               &info);
+        landmarks += static_cast<double>(l.ids.size());
         ++i;
         ++j;
       }
     }
-    return logDetInformation(info, config_.information.epsilon);
+    return scoreInformation(info, landmarks, config_.information);
   }
 
   // Cost per metre of an edge with score c: lambda_d + lambda_p f(c - c_p,thr) (eq. 9's sigmoid:

@@ -55,7 +55,7 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
       landmark_slot_[static_cast<std::size_t>(id)] = static_cast<int>(landmark_voxels_.size());
     }
     const Eigen::Vector3d mean = sum / static_cast<double>(ids.size());
-    landmark_voxels_.push_back({index, centreOf(index), mean, std::move(ids)});
+    landmark_voxels_.push_back({index, centreOf(index), mean, surfaceNormal(index), std::move(ids)});
   }
   auto layer = [&](double z) {
     return static_cast<int>(std::clamp(std::floor((z - origin_.z()) / res_), -1.0, static_cast<double>(size_.z())));
@@ -196,6 +196,28 @@ void VoxelMap::computeDistanceField() {
 
 double VoxelMap::centreDistance(const Eigen::Vector3i& c) const {
   return std::sqrt(static_cast<double>(dist2_[padded(c)])) * res_;
+}
+
+Eigen::Vector3d VoxelMap::surfaceNormal(int index) const {
+  const int x = index % size_.x();
+  const int y = (index / size_.x()) % size_.y();
+  const int z = index / (size_.x() * size_.y());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int free = 0;
+  for (int dz = -2; dz <= 2; ++dz) {
+    for (int dy = -2; dy <= 2; ++dy) {
+      for (int dx = -2; dx <= 2; ++dx) {
+        const Eigen::Vector3i c(x + dx, y + dy, z + dz);
+        if ((dx == 0 && dy == 0 && dz == 0) || !inside(c)) continue;
+        if (state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] != VoxelState::kFree) continue;
+        sum += Eigen::Vector3d(dx, dy, dz).normalized();
+        ++free;
+      }
+    }
+  }
+  // Free space on one side only: the mean direction is long (about 0.5 for a flat wall).
+  if (free == 0 || sum.norm() < 0.25 * free) return Eigen::Vector3d::Zero();
+  return sum.normalized();
 }
 
 double VoxelMap::clearance(const Eigen::Vector3d& p_W) const { return clearance(p_W, nullptr); }

@@ -23,7 +23,10 @@ struct LandmarkVoxel {
   int index = 0;             // flat voxel index in the VoxelMap
   Eigen::Vector3d centre_W;  // voxel centre
   Eigen::Vector3d mean_W;    // mean position of its landmarks
-  std::vector<int> ids;      // landmark ids, ascending
+  // Outward surface normal: the mean direction to the free voxels within two voxels (unit; zero
+  // where free space lies on opposite sides alike, e.g. a thin panel, or there is none).
+  Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();
+  std::vector<int> ids;  // landmark ids, ascending
 };
 
 class VoxelMap {
@@ -70,6 +73,7 @@ class VoxelMap {
   Eigen::Vector3i cellOf(const Eigen::Vector3d& p_W) const;
   bool inside(const Eigen::Vector3i& c) const { return (c.array() >= 0).all() && (c.array() < size_.array()).all(); }
   Eigen::Vector3d centreOf(int index) const;
+  Eigen::Vector3d surfaceNormal(int index) const;
   double centreDistance(const Eigen::Vector3i& c) const;
   void computeDistanceField();
 

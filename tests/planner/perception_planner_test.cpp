@@ -57,6 +57,45 @@ TEST(SelectionCost, FeatureRichBeatsFeaturePoorUpToTheBreakeven) {
   EXPECT_LT(selectionCost(d_min, d_min, 10.0, table1), selectionCost(d_min, d_min, 2.0, table1));
 }
 
+CandidatePath candidate(double length_m, double c_p_min) {
+  CandidatePath c;
+  c.feasible = true;
+  c.length_m = length_m;
+  c.c_p_min = c_p_min;
+  return c;
+}
+
+TEST(SelectCandidate, BelowTheThresholdPerceptionComesFirst) {
+  const double blind = 6.0 * std::log(InformationConfig{}.epsilon);
+  SelectionConfig config;  // perception_first, tolerance 1.0
+  // No class reaches c_p,thr = 6: the weak-but-seeing class wins over the shorter blind one,
+  // though eq. 9 alone prefers the shorter (both pay ~eta_p).
+  std::vector<CandidatePath> weak{candidate(14.0, blind), candidate(17.0, 0.5), candidate(15.0, blind)};
+  EXPECT_EQ(selectCandidate(weak, config), 1);
+  EXPECT_LT(weak[0].cost, weak[1].cost);
+  SelectionConfig paper = config;
+  paper.perception_first = false;
+  EXPECT_EQ(selectCandidate(weak, paper), 0);
+  // Within the tolerance of the best c_p,min, eq. 9 decides: the shorter of 0.5 and 0.2 wins.
+  std::vector<CandidatePath> close{candidate(20.0, 0.5), candidate(16.0, 0.2), candidate(14.0, blind)};
+  EXPECT_EQ(selectCandidate(close, config), 1);
+  // All blind: the shortest, as before.
+  std::vector<CandidatePath> all_blind{candidate(18.0, blind), candidate(14.0, blind)};
+  EXPECT_EQ(selectCandidate(all_blind, config), 1);
+  // Some class reaches c_p,thr: eq. 9 alone, as in the paper (a much longer rich class can lose
+  // to a shorter class just under the threshold).
+  std::vector<CandidatePath> above{candidate(100.0, 30.0), candidate(14.0, 5.9)};
+  EXPECT_EQ(selectCandidate(above, config), 1);
+  EXPECT_EQ(selectCandidate(above, paper), 1);
+  // Infeasible candidates are never chosen; none feasible: -1.
+  std::vector<CandidatePath> none{candidate(10.0, 20.0)};
+  none[0].feasible = false;
+  EXPECT_EQ(selectCandidate(none, config), -1);
+  SelectionConfig bad = config;
+  bad.perception_tolerance = -1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Generated scenes, each with one free-standing solid in a box, so exactly two homology classes.
 // Landmarks every 0.1 m on faces along the longer class; the shorter class passes a stretch from
@@ -337,9 +376,11 @@ void expectSamePlan(const Plan& a, const Plan& b) {
 
 TEST(PerceptionPlanner, SameSeedSamePlanWhateverTheThreadCount) {
   const Scene& scene = sceneA();
+  // With random positions (the paper's sampling; the default lattice does not use the seed).
   PerceptionPlannerConfig one = plannerConfig();
+  one.graph.random_positions = true;
   one.threads = 1;
-  PerceptionPlannerConfig two = plannerConfig();
+  PerceptionPlannerConfig two = one;
   two.threads = 2;
   const Plan a = ProposedPlanner(*scene.voxels, one).solve({scene.start, scene.goal, 42});
   const Plan b = ProposedPlanner(*scene.voxels, two).solve({scene.start, scene.goal, 42});

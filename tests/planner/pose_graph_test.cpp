@@ -242,6 +242,34 @@ TEST(PoseGraph, CorridorSearchIsDeterministicFeasibleAndRateLimited) {
             << " nodes collision-free, " << a.edges << " edges, c_d " << a.c_d << " m, c_p " << a.c_p << "\n";
 }
 
+TEST(PoseGraph, TheLatticeIgnoresTheSeedAndRandomPositionsDoNot) {
+  const Corridor& c = texturedCorridor(+1);
+  const PoseGraphConfig lattice;
+  ASSERT_FALSE(lattice.random_positions);
+  const PoseGraphResult a = search(c, lattice, 7);
+  const PoseGraphResult b = search(c, lattice, 12345);
+  expectFeasible(c, a, lattice);
+  ASSERT_EQ(a.path.size(), b.path.size());
+  for (std::size_t j = 0; j < a.path.size(); ++j) {
+    EXPECT_EQ(a.path[j].p_WB, b.path[j].p_WB) << "layer " << j;
+    EXPECT_EQ(a.path[j].yaw_rad, b.path[j].yaw_rad) << "layer " << j;
+  }
+  EXPECT_EQ(a.cost, b.cost);
+  // Every lattice point lies on the disk of R_sample around the reference path's point.
+  for (std::size_t j = 0; j < a.path.size(); ++j) {
+    EXPECT_LE((a.path[j].p_WB - pointAt(c.path, a.layer_s[j])).norm(), lattice.sample_radius_m + 1e-9) << j;
+  }
+  PoseGraphConfig random = lattice;
+  random.random_positions = true;
+  const PoseGraphResult r7 = search(c, random, 7);
+  const PoseGraphResult r8 = search(c, random, 8);
+  expectFeasible(c, r7, random);
+  expectFeasible(c, r8, random);
+  bool differ = false;
+  for (std::size_t j = 0; j < r7.path.size() && j < r8.path.size(); ++j) differ |= r7.path[j].p_WB != r8.path[j].p_WB;
+  EXPECT_TRUE(differ || r7.path.size() != r8.path.size());
+}
+
 TEST(PoseGraph, PerceptionPullsTheYawTowardsTheTexturedWall) {
   const PoseGraphConfig config;
   for (int side : {+1, -1}) {
