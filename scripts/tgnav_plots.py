@@ -63,18 +63,32 @@ map  (a `tgnav map` folder) -> topdown
                       make the second title line
   topdown: the raster in metres with start, goal and the map.json legend.
 
-report  (a `tgnav report` folder) -> fig3_<scene>, fig4_<scene> per scene, plan_time
+report  (a `tgnav report` folder) -> fig3_<scene>, fig4_<scene>, tracking_<scene> per scene,
+        plan_time, calibration
   report.json      required, as `tgnav report` writes it: `scenes` [{"name", "map" (image file
                    in DIR, or null), "extent_m", "start_xy", "goal_xy"}], `groups`
                    [{"label", "scene", "successes", "plan_time_s" ({"n", "mean", "std"} or
-                   null), "trials": [{"folder" (absolute), "status", "vo_lost_position"}]}];
+                   null), "trials": [{"folder" (absolute), "status", "vo_lost_position",
+                   optional "seed", "oracle_class", "c_p_threshold", "min_inliers" (the VO's
+                   lost threshold)}]}];
                    each trial folder's gt.tum and vo.csv are read
                    (a missing one leaves the trial out, and the figure says how many)
+  vo.csv           read by header names: status (ok, weak, lost), features, inliers,
+                   x_true.., x_est..; optional predicted_score (the planner's perception model
+                   at the frame's true pose: log det of the Fisher information) and
+                   predicted_landmarks (map landmarks in the camera's field of view)
   fig3_<scene>: every trial's true xy path over the scene's map, one panel per group
   (green: VO success, red: failed, x: VO lost; the paper's Fig. 3).
   fig4_<scene>: VO position error against distance travelled, per group the mean over the
   trials still tracking with the min-max band, and an X where each lost trial ended.
   plan_time: mean planning time per group with std error bars, log scale.
+  tracking_<scene>: one small panel per trial (rows: groups, columns: their trials): tracked
+  features and inliers against distance travelled, lost frames as red x over a red band, the
+  VO's min_inliers dashed (only when some trial of the scene has vo.csv frames).
+  calibration: predicted_score against inliers for every frame of every trial (oracle ones
+  too), green while the VO was tracking, red when lost, the median per bin, c_p_threshold as a
+  vertical line and min_inliers as a horizontal one; a second panel against
+  predicted_landmarks when vo.csv has it. Not drawn when no vo.csv has predicted_score.
 """
 import argparse
 import csv
@@ -83,6 +97,7 @@ import json
 import logging
 import math
 import os
+import re
 import sys
 import warnings
 from dataclasses import dataclass
@@ -774,6 +789,86 @@ class ReportTrial:
     vo_lost: tuple  # (x, y) or None
     gt_xy: "np.ndarray"  # the true path, n x 2; None without gt.tum or rows
     vo: tuple  # (distance, error) at the tracked frames; None without vo.csv or frames
+    seed: int = 0
+    oracle_class: int = None  # the class flown on request, or None
+    c_p_threshold: float = None  # plan.json's, or None
+    min_inliers: int = None  # the VO's lost threshold (config.yaml), or None
+    frames: "VoFrames" = None  # every frame of vo.csv, or None without vo.csv or frames
+
+
+@dataclass
+class VoFrames:
+    """A trial's vo.csv, per camera frame."""
+    distance: "np.ndarray"  # travelled along the true camera path
+    features: "np.ndarray"
+    inliers: "np.ndarray"
+    tracking: "np.ndarray"  # bool: status ok or weak (not lost)
+    error: "np.ndarray"  # |p_est - p_true|, NaN where not tracked
+    predicted_score: "np.ndarray"  # None without the column (the perception model's log det)
+    predicted_landmarks: "np.ndarray"  # None without the column
+
+
+VO_COLUMNS = ("status", "features", "inliers", "x_true", "y_true", "z_true", "x_est", "y_est", "z_est")
+VO_OPTIONAL = ("predicted_score", "predicted_landmarks")
+
+
+VO_EMPTY_CELL = re.compile(r"(?:(?<=,)|^)(?=,|$)", re.M)
+
+
+def vo_numbers(path, header, body, names):
+    """Columns `names` of the rows `body` as an n x len(names) float array, empty cells NaN; parsed
+    by numpy in C (a report reads hundreds of vo.csv files)."""
+    usecols = [header.index(name) for name in names]
+    try:
+        return np.loadtxt(VO_EMPTY_CELL.sub("nan", "\n".join(body)).splitlines(), delimiter=",", usecols=usecols,
+                          dtype=float, ndmin=2, comments=None)
+    except ValueError:
+        for k, line in enumerate(body):  # slow, only to name the cell
+            cells = line.split(",")
+            for name, column in zip(names, usecols):
+                parse_number(cells[column], path, k + 2, name, may_be_empty=True)
+        raise
+
+
+def read_vo_frames(path):
+    """vo.csv read by its header names (any column order, unknown columns ignored), fast enough for
+    hundreds of trials: a VoFrames, or None when it has no frames. Empty cells are NaN; blank
+    lines end the rows (line numbers in errors count from the header)."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().splitlines()
+    except FileNotFoundError:
+        raise DataError(path, "missing") from None
+    except OSError as e:
+        raise DataError(path, f"cannot read: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise DataError(path, f"not CSV text: {e}") from None
+    while lines and not lines[-1].strip():
+        lines.pop()
+    if not lines:
+        raise DataError(path, "empty: no header row")
+    header = [name.strip() for name in lines[0].split(",")]
+    missing = [column for column in VO_COLUMNS if column not in header]
+    if missing:
+        raise DataError(path, f"no column {', '.join(missing)} in the header row")
+    body = lines[1:]
+    for k, line in enumerate(body):
+        if line.count(",") != len(header) - 1:
+            raise DataError(path, f"line {k + 2}: {line.count(',') + 1} fields, the header has {len(header)}")
+    if not body:
+        return None
+    optional = [c for c in VO_OPTIONAL if c in header]
+    names = list(VO_COLUMNS[1:]) + optional
+    numbers = dict(zip(names, vo_numbers(path, header, body, names).T))
+    true = np.column_stack([numbers[c] for c in ("x_true", "y_true", "z_true")])
+    est = np.column_stack([numbers[c] for c in ("x_est", "y_est", "z_est")])
+    steps = np.linalg.norm(np.diff(true, axis=0), axis=1)
+    column = header.index("status")
+    status = np.array([line.split(",", column + 1)[column].strip() for line in body])
+    return VoFrames(distance=np.cumsum(np.concatenate([[0.0], np.where(np.isfinite(steps), steps, 0.0)])),
+                    features=numbers["features"], inliers=numbers["inliers"],
+                    tracking=(status == "ok") | (status == "weak"), error=np.linalg.norm(est - true, axis=1),
+                    **{c: numbers.get(c) for c in VO_OPTIONAL})
 
 
 @dataclass
@@ -794,6 +889,7 @@ class ReportScene:
     layer: MapLayer  # or None: figure 3 then spans the trajectories
 
 
+
 def report_gt_xy(folder):
     path = os.path.join(folder, "gt.tum")
     if not os.path.exists(path):
@@ -802,24 +898,34 @@ def report_gt_xy(folder):
     return xy if len(xy) else None
 
 
-def report_vo(folder):
+def report_frames(folder):
     path = os.path.join(folder, "vo.csv")
-    if not os.path.exists(path):
-        return None
-    distance, error = vo_error(read_vo_csv(path))
-    if not len(distance):
-        return None
-    tracked = np.isfinite(error)
-    return distance[tracked], error[tracked]
+    return read_vo_frames(path) if os.path.exists(path) else None
+
+
+def optional_number(trial, key):
+    return trial.get(key).number() if trial.get(key) else None
 
 
 def load_report_trial(trial):
     folder = trial["folder"].text()
+    frames = report_frames(folder)
+    vo = None
+    if frames is not None:
+        tracked = np.isfinite(frames.error)
+        vo = frames.distance[tracked], frames.error[tracked]
+    min_inliers = optional_number(trial, "min_inliers")
+    oracle = trial.get("oracle_class")
     return ReportTrial(
         status=trial["status"].text(),
         vo_lost=trial.get("vo_lost_position").xy() if trial.get("vo_lost_position") else None,
         gt_xy=report_gt_xy(folder),
-        vo=report_vo(folder),
+        vo=vo,
+        seed=trial["seed"].integer() if trial.get("seed") else 0,
+        oracle_class=oracle.integer() if oracle else None,
+        c_p_threshold=optional_number(trial, "c_p_threshold"),
+        min_inliers=int(min_inliers) if min_inliers is not None else None,
+        frames=frames,
     )
 
 
@@ -1016,8 +1122,168 @@ def plan_time_figure(scenes, groups, colours):
     return fig
 
 
+TRACKING_PANEL_IN = (2.3, 1.45)  # one trial's panel in tracking_<scene>
+TRACKING_COLUMNS = 10  # panels per row; a group with more trials takes more rows
+FEATURES = "#9a9a9a"
+INLIERS = "#1f5fbf"
+TRACKING = "#2ca02c"
+
+
+def lost_spans(distance, tracking):
+    """(start, end) distances of the runs of frames that were not tracking."""
+    lost = np.concatenate([[False], ~tracking, [False]]).astype(int)
+    edges = np.flatnonzero(np.diff(lost))
+    spans = []
+    for begin, end in zip(edges[::2], edges[1::2]):
+        stop = distance[end] if end < distance.size else distance[-1]
+        spans.append((distance[begin - 1] if begin > 0 else distance[begin], stop))
+    return spans
+
+
+def tracking_panel(ax, trial):
+    frames = trial.frames
+    ax.plot(frames.distance, frames.features, color=FEATURES, lw=0.8, label="features")
+    ax.plot(frames.distance, frames.inliers, color=INLIERS, lw=0.9, label="inliers")
+    for begin, end in lost_spans(frames.distance, frames.tracking):
+        ax.axvspan(begin, end, color=FAILED, alpha=0.15, lw=0)
+    lost = ~frames.tracking
+    if lost.any():
+        ax.plot(frames.distance[lost], frames.inliers[lost], ls="", marker="x", ms=3, mew=0.8, color=FAILED,
+                label="lost frame")
+    if trial.min_inliers is not None:
+        ax.axhline(trial.min_inliers, color=FAILED, lw=0.7, ls="--", label="min. inliers")
+
+
+def tracking_layout(groups, max_columns):
+    """(group, trial or None, first row of the group) per panel row: a group's trials in rows of
+    at most `max_columns`."""
+    rows = []
+    for group in groups:
+        trials = group.trials or [None]
+        for start in range(0, len(trials), max_columns):
+            rows.append((group, trials[start:start + max_columns], start == 0))
+    return rows
+
+
+def tracking_limits(groups):
+    """x and y upper limits common to every panel: the longest distance, the most features."""
+    frames = [t.frames for g in groups for t in g.trials if t.frames is not None]
+    x = max([float(np.nanmax(f.distance)) for f in frames if f.distance.size] + [1.0])
+    y = max([float(np.nanmax(np.concatenate([f.features, f.inliers]))) for f in frames if f.features.size] + [1.0])
+    return 1.02 * x, 1.05 * y
+
+
+def tracking_axes(fig, rows, columns):
+    """rows x columns panels with the same limits set by hand: shared axes cost time quadratic in
+    the panels, and a report may have hundreds."""
+    margin = {"left": 1.0 / fig.get_figwidth(), "right": 1 - 0.2 / fig.get_figwidth(),
+              "top": 1 - 0.55 / fig.get_figheight(), "bottom": 0.8 / fig.get_figheight()}
+    return fig.subplots(rows, columns, squeeze=False, gridspec_kw=dict(hspace=0.45, wspace=0.08, **margin))
+
+
+@styled
+def tracking_figure(scene, groups):
+    """One panel per trial (rows: groups, wrapped after TRACKING_COLUMNS trials): features and
+    inliers against distance travelled, lost frames in red."""
+    most = max([len(g.trials) for g in groups] + [1])
+    columns = math.ceil(most / math.ceil(most / TRACKING_COLUMNS))  # wrapped rows about as long
+    layout = tracking_layout(groups, columns)
+    fig = Figure(figsize=(TRACKING_PANEL_IN[0] * columns + 1.2, TRACKING_PANEL_IN[1] * len(layout) + 1.0))
+    axes = tracking_axes(fig, len(layout), columns)
+    x_max, y_max = tracking_limits(groups)
+    lowest = [max([r for r, (_, trials, _) in enumerate(layout) if len(trials) > c] or [0]) for c in range(columns)]
+    for r, (row, (group, trials, first)) in enumerate(zip(axes, layout)):
+        for c, (ax, trial) in enumerate(zip(row, trials)):
+            if trial is None or trial.frames is None:
+                ax.text(0.5, 0.5, "no vo.csv frames", ha="center", va="center", transform=ax.transAxes, fontsize=7)
+            else:
+                tracking_panel(ax, trial)
+            if trial is not None:  # a text, not a title: titles are placed panel by panel, slowly
+                ax.text(0.5, 1.02, f"seed {trial.seed}: {trial.status}", transform=ax.transAxes, ha="center",
+                        va="bottom", fontsize=7, color=SUCCESS if trial.status == "success" else FAILED)
+            ax.set_xlim(0.0, x_max)
+            ax.set_ylim(0.0, y_max)
+            ax.tick_params(labelsize=6, labelbottom=r == lowest[c], labelleft=c == 0)
+            if r == lowest[c]:
+                ax.set_xlabel("distance [m]", fontsize=7)
+        for ax in row[len(trials):]:
+            ax.axis("off")
+        if first:
+            row[0].set_ylabel(group.label.replace(" [", "\n["), fontsize=7)
+    legend = [Line2D([], [], color=FEATURES, lw=1.5, label="features"),
+              Line2D([], [], color=INLIERS, lw=1.5, label="inliers"),
+              Line2D([], [], ls="", marker="x", color=FAILED, label="lost frame (shaded: lost stretch)"),
+              Line2D([], [], color=FAILED, ls="--", lw=1, label="VO min. inliers")]
+    fig.legend(handles=legend, loc="lower center", ncol=len(legend), frameon=False, fontsize=8)
+    fig.suptitle(f"{scene.name}: VO tracking per trial (rows: planner groups)", fontsize=11,
+                 y=1 - 0.1 / fig.get_figheight(), va="top")
+    return fig
+
+
+def binned_median(x, y, bins=24):
+    """Bin centres and the median of y in each of `bins` equal bins of x (NaN where empty)."""
+    edges = np.linspace(x.min(), x.max(), bins + 1) if x.size else np.zeros(bins + 1)
+    which = np.clip(np.digitize(x, edges) - 1, 0, bins - 1)
+    medians = np.array([np.median(y[which == k]) if np.any(which == k) else np.nan for k in range(bins)])
+    return 0.5 * (edges[:-1] + edges[1:]), medians
+
+
+def calibration_points(groups):
+    """Every frame with a finite predicted_score: score, landmarks (NaN without), inliers, tracking."""
+    parts = []
+    for trial in (t for g in groups for t in g.trials):
+        f = trial.frames
+        if f is None or f.predicted_score is None:
+            continue
+        landmarks = f.predicted_landmarks if f.predicted_landmarks is not None else np.full(f.inliers.size, np.nan)
+        keep = np.isfinite(f.predicted_score) & np.isfinite(f.inliers)
+        parts.append(np.column_stack([f.predicted_score, landmarks, f.inliers, f.tracking])[keep])
+    return np.concatenate(parts) if parts else None
+
+
+def calibration_scatter(ax, x, inliers, tracking):
+    for mask, colour, label, ms in ((tracking, TRACKING, "tracking (ok, weak)", 2.5), (~tracking, FAILED, "lost", 4)):
+        ax.plot(x[mask], inliers[mask], ls="", marker=".", ms=ms, alpha=0.4, color=colour, rasterized=True,
+                label=f"{label}: {int(mask.sum())} frames")
+    if x.size:
+        centres, medians = binned_median(x, inliers)
+        ax.plot(centres, medians, color="black", lw=1.4, label="median inliers per bin")
+    ax.grid(True, color="#e6e6e6")
+    ax.set_ylabel("VO inliers")
+    ax.set_ylim(bottom=0.0)
+
+
+@styled
+def calibration_figure(groups, points):
+    """Predicted perception score (and landmarks in view) against the VO's inliers, every frame."""
+    landmarks = np.isfinite(points[:, 1]).any()
+    fig = Figure(figsize=(11.0 if landmarks else 6.5, 4.8), layout="constrained")
+    axes = fig.subplots(1, 2 if landmarks else 1, squeeze=False)[0]
+    tracking = points[:, 3].astype(bool)
+    trials = [t for g in groups for t in g.trials]
+    thresholds = sorted({t.c_p_threshold for t in trials if t.c_p_threshold is not None})
+    min_inliers = sorted({t.min_inliers for t in trials if t.min_inliers is not None})
+    calibration_scatter(axes[0], points[:, 0], points[:, 2], tracking)
+    for k, threshold in enumerate(thresholds):
+        axes[0].axvline(threshold, color=PLANNED, lw=1.2, ls="-.", label=r"$c_{p,thr}$" if k == 0 else None)
+    axes[0].set_xlabel("predicted score (log det of the Fisher information)")
+    if landmarks:
+        finite = np.isfinite(points[:, 1])
+        calibration_scatter(axes[1], points[finite, 1], points[finite, 2], tracking[finite])
+        axes[1].set_xlabel("predicted landmarks in view")
+    for ax in axes:
+        for k, value in enumerate(min_inliers):
+            ax.axhline(value, color=FAILED, lw=1.0, ls="--", label="VO min. inliers" if k == 0 else None)
+    axes[0].legend(fontsize=7, loc="upper left", markerscale=4)
+    counted = sum(t.frames is not None and t.frames.predicted_score is not None for t in trials)
+    fig.suptitle(f"Perception model against the VO: {points.shape[0]} frames of {counted} trials", fontsize=11)
+    return fig
+
+
 def report_figures(folder):
-    """{"fig3_<scene>", "fig4_<scene>" per scene, "plan_time": Figure} of a `tgnav report` folder."""
+    """{"fig3_<scene>", "fig4_<scene>", "tracking_<scene>" per scene, "plan_time", "calibration": Figure}
+    of a `tgnav report` folder (tracking_<scene> only with vo.csv frames, calibration only when some
+    vo.csv has predicted_score)."""
     doc = read_json(os.path.join(folder, "report.json"))
     scenes = [load_report_scene(s, folder) for s in doc["scenes"].items()]
     groups = [load_report_group(g) for g in doc["groups"].items()]
@@ -1027,7 +1293,12 @@ def report_figures(folder):
         scene_groups = [g for g in groups if g.scene == scene.name]
         figures[f"fig3_{scene.name}"] = fig3_figure(scene, scene_groups)
         figures[f"fig4_{scene.name}"] = fig4_figure(scene, scene_groups, colours)
+        if any(t.frames is not None for g in scene_groups for t in g.trials):
+            figures[f"tracking_{scene.name}"] = tracking_figure(scene, scene_groups)
     figures["plan_time"] = plan_time_figure(scenes, groups, colours)
+    points = calibration_points(groups)
+    if points is not None:  # no trial has predicted_score: no calibration plot (table2.md says so)
+        figures["calibration"] = calibration_figure(groups, points)
     return figures
 
 

@@ -13,6 +13,7 @@
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
+#include "harness/experiments/report_trial.h"
 #include "harness/io/staged_output.h"
 
 namespace tgnav::harness {
@@ -145,27 +146,6 @@ class RowReader {
   const std::vector<std::string>& fields_;
 };
 
-// What the report takes from a trial's metrics.json beyond index.csv.
-void readMetrics(const fs::path& file, const std::string& shown, IndexRow& row) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(readTextFile(file));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(shown + ": not valid JSON: " + e.what());
-  }
-  if (!j.is_object()) throw InputError(shown + ": not a JSON object");
-  const auto ok = j.find("vo_ok");
-  const auto weak = j.find("vo_weak");
-  if (ok != j.end() && weak != j.end() && ok->is_number() && weak->is_number()) {
-    row.tracked_frames = ok->get<double>() + weak->get<double>() > 0;
-  }
-  const auto lost = j.find("vo_lost_position");
-  if (lost != j.end() && lost->is_array() && lost->size() == 3 &&
-      std::all_of(lost->begin(), lost->end(), [](const nlohmann::json& v) { return v.is_number(); })) {
-    row.vo_lost_position = lost->get<std::vector<double>>();
-  }
-}
-
 IndexRow parseRow(const fs::path& file, const fs::path& dir, int line, const std::string& text) {
   const std::vector<std::string> fields = splitFields(text, ',');
   if (fields.size() != kIndexColumns.size()) {
@@ -200,14 +180,11 @@ IndexRow parseRow(const fs::path& file, const fs::path& dir, int line, const std
   if (!fs::is_regular_file(row.folder / "metrics.json", ec)) {
     throw InputError(r.where() + ": trial " + row.id + ": " + metrics + " is missing");
   }
-  readMetrics(row.folder / "metrics.json", (file.parent_path() / metrics).string(), row);
+  readTrialMetrics(row.folder / "metrics.json", (file.parent_path() / metrics).string(), row);
+  if (fs::is_regular_file(row.folder / "plan.json", ec)) {
+    readTrialPlan(row.folder / "plan.json", (file.parent_path() / folder / "plan.json").string(), row);
+  }
   return row;
-}
-
-std::string csvNumber(double v) {
-  char s[40];
-  std::snprintf(s, sizeof s, "%.10g", v);
-  return s;
 }
 
 std::string csvSummary(const std::optional<Summary>& s) {
@@ -239,12 +216,18 @@ std::size_t displayWidth(const std::string& s) {
       std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
+}  // namespace
+
+std::string csvNumber(double v) {
+  char s[40];
+  std::snprintf(s, sizeof s, "%.10g", v);
+  return s;
+}
+
 std::string markdownCell(std::string s) {
   for (std::size_t i = s.find('|'); i != std::string::npos; i = s.find('|', i + 2)) s.replace(i, 1, "\\|");
   return s;
 }
-
-}  // namespace
 
 std::vector<IndexRow> parseIndexCsv(const std::string& text, const fs::path& file, const fs::path& dir) {
   const auto lines = csvLines(text);
@@ -407,6 +390,30 @@ std::string table2Csv(const std::vector<TableRow>& rows) {
   return out.str();
 }
 
+std::string markdownTable(const std::vector<std::string>& header, const std::vector<bool>& right,
+                          const std::vector<std::vector<std::string>>& cells) {
+  std::vector<std::size_t> width(header.size());
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    width[c] = std::max<std::size_t>(3, displayWidth(header[c]));
+    for (const auto& row : cells) width[c] = std::max(width[c], displayWidth(row[c]));
+  }
+  auto line = [&](const std::vector<std::string>& row) {
+    std::string s = "|";
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      const std::string pad(width[c] - displayWidth(row[c]), ' ');
+      s += " " + (right[c] ? pad + row[c] : row[c] + pad) + " |";
+    }
+    return s + "\n";
+  };
+  std::string out = line(header) + "|";
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    out += (right[c] ? " " + std::string(width[c] - 1, '-') + ":" : " " + std::string(width[c], '-')) + " |";
+  }
+  out += "\n";
+  for (const auto& row : cells) out += line(row);
+  return out;
+}
+
 std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std::optional<int> manifest,
                            const std::string& sweep_name) {
   const std::vector<std::string> header = {"Scene",         "Planner",         "Trials",
@@ -422,21 +429,6 @@ std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std:
                      std::to_string(t.successes) + "/" + std::to_string(t.trials), formatSummary(t.plan_time_s),
                      formatSummary(t.ate_rmse_m), formatOutcomes(t.outcomes)});
   }
-  // Padded columns keep the raw text readable on a terminal.
-  std::vector<std::size_t> width(header.size());
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    width[c] = std::max<std::size_t>(3, displayWidth(header[c]));
-    for (const auto& row : cells) width[c] = std::max(width[c], displayWidth(row[c]));
-  }
-  auto line = [&](const std::vector<std::string>& row) {
-    std::string s = "|";
-    for (std::size_t c = 0; c < row.size(); ++c) {
-      const std::string pad(width[c] - displayWidth(row[c]), ' ');
-      s += " " + (right[c] ? pad + row[c] : row[c] + pad) + " |";
-    }
-    return s + "\n";
-  };
-
   std::ostringstream out;
   out << "# Table II: " << sweep_name << "\n\n";
   if (manifest) {
@@ -444,12 +436,7 @@ std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std:
   } else {
     out << finished << " trials finished (the sweep has no trials.csv manifest).\n\n";
   }
-  out << line(header) << "|";
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    out << (right[c] ? " " + std::string(width[c] - 1, '-') + ":" : " " + std::string(width[c], '-')) << " |";
-  }
-  out << "\n";
-  for (const auto& row : cells) out << line(row);
+  out << markdownTable(header, right, cells);
   out << "\nMean ± sample standard deviation over the trials of each group. Length: the flown (ground-truth) "
          "path, trials that flew. *Goal error: |estimated − true| final position, over successful trials only "
          "(as in the paper's Table II). VO success: trials whose VO tracked all the way to the goal. ATE RMSE: "

@@ -1,6 +1,7 @@
 #pragma once
 // `tgnav report`: a sweep folder (made by `tgnav sweep`) aggregated into the paper's Table II
-// and the data its figures are drawn from (scripts/report_plots.py draws them).
+// and the data its figures are drawn from (scripts/tgnav_plots.py draws them); the per-scene and
+// generalisation tables are in report_scenes.h.
 //
 // Sweep folder contract:
 //   DIR/trials.csv   every trial of the sweep: id,scenario,scene,planner,samples,seed,params
@@ -51,6 +52,14 @@ struct IndexRow {
   // where the VO was first lost (x, y, z of the body in W).
   std::optional<bool> tracked_frames;
   std::optional<std::vector<double>> vo_lost_position;
+  // The homology classes (report_trial.h): the oracle's class (none: the planner chose), the class
+  // flown (an index into plan.json's classes, the same for every planner of a scene), how many the
+  // scene has; from plan.json the chosen class's weakest segment score and the planner's threshold.
+  std::optional<int> oracle_class;
+  std::optional<int> chosen_class;
+  std::optional<int> classes;
+  std::optional<double> chosen_c_p_min;
+  std::optional<double> c_p_threshold;
 };
 
 struct SweepIndex {
@@ -118,6 +127,14 @@ std::string formatSummary(const std::optional<Summary>& s);
 // "8 success, 2 vo_lost".
 std::string formatOutcomes(const std::vector<std::pair<std::string, int>>& outcomes);
 
+// A Markdown table with padded columns (readable on a terminal); `right` aligns a column right.
+std::string markdownTable(const std::vector<std::string>& header, const std::vector<bool>& right,
+                          const std::vector<std::vector<std::string>>& cells);
+// Text for a Markdown cell ('|' escaped).
+std::string markdownCell(std::string s);
+// A number for a CSV cell (%.10g).
+std::string csvNumber(double v);
+
 // Machine-friendly table: raw numbers, mean and std in separate columns, empty cells for none.
 std::string table2Csv(const std::vector<TableRow>& rows);
 // Title, "<finished> of <manifest> trials finished", the table with each scene named once at the
@@ -125,5 +142,4 @@ std::string table2Csv(const std::vector<TableRow>& rows);
 std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std::optional<int> manifest,
                            const std::string& sweep_name);
 
-// The top-down map picture behind a scene's trajectories (figure 3) and where it lies in W.
 }  // namespace tgnav::harness

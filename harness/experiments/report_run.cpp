@@ -5,6 +5,8 @@
 
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
+#include "harness/experiments/report_scenes.h"
+#include "harness/experiments/report_trial.h"
 #include "harness/io/staged_output.h"
 #include "harness/io/topdown.h"
 #include "harness/run/map_cache.h"
@@ -38,11 +40,23 @@ std::vector<SceneBackground> backgrounds(const SweepIndex& sweep, const fs::path
   return out;
 }
 
-nlohmann::json orNull(const std::optional<double>& v) { return v ? nlohmann::json(*v) : nlohmann::json(nullptr); }
+template <typename T>
+nlohmann::json orNull(const std::optional<T>& v) {
+  return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+}
 
 nlohmann::json summaryJson(const std::optional<Summary>& s) {
   if (!s) return nullptr;
   return {{"n", s->n}, {"mean", s->mean}, {"std", s->std}};
+}
+
+// What the figures leave out, for table2.md: the calibration plot needs the perception model's
+// prediction per camera frame (vo.csv's predicted_score).
+std::string figureNotes(const SweepIndex& sweep) {
+  const bool any = std::any_of(sweep.rows.begin(), sweep.rows.end(),
+                               [](const IndexRow& r) { return voCsvHasColumn(r.folder, "predicted_score"); });
+  if (any) return "";
+  return "\nFigures: no calibration plot (calibration): no trial's vo.csv has a predicted_score column.\n";
 }
 
 // Writes report.json and the map images and runs the figures; "" or why they failed.
@@ -123,7 +137,11 @@ nlohmann::json reportJson(const SweepIndex& sweep, const std::vector<ReportGroup
            {"plan_time_s", orNull(r.plan_time_s)},
            {"vo_lost_at_s", orNull(r.vo_lost_at_s)},
            {"distance_tracked_m", orNull(r.distance_tracked_m)},
-           {"vo_lost_position", r.vo_lost_position ? nlohmann::json(*r.vo_lost_position) : nlohmann::json(nullptr)}});
+           {"vo_lost_position", r.vo_lost_position ? nlohmann::json(*r.vo_lost_position) : nlohmann::json(nullptr)},
+           {"oracle_class", orNull(r.oracle_class)},
+           {"chosen_class", orNull(r.chosen_class)},
+           {"c_p_threshold", orNull(r.c_p_threshold)},
+           {"min_inliers", orNull(trialMinInliers(r.folder))}});
     }
     j["groups"].push_back({{"label", group.label},
                            {"scene", group.scene},
@@ -154,8 +172,19 @@ ReportRunResult runReport(const ReportJob& job) {
       table2Markdown(table, static_cast<int>(sweep.rows.size()), sweep.manifest_trials, sweep.dir.filename().string());
   r.groups = groups.size();
   r.trials = sweep.rows.size();
+  const bool per_scene = wantsSceneTable(sweep.rows);
+  const std::vector<SceneReport> scenes = sceneReports(sweep.rows);
+  const std::vector<AggregateRow> aggregate = aggregateRows(sweep.rows, scenes);
+  r.markdown += generalisationMarkdown(scenes, aggregate, per_scene);
+  if (!job.no_plots) r.markdown += figureNotes(sweep);
   makeOutputDir(r.out);
   writeFileAtomic(r.out / "table2.csv", table2Csv(table));
+  if (per_scene) {
+    writeFileAtomic(r.out / "scenes.csv", scenesCsv(scenes));
+  } else {
+    fs::remove(r.out / "scenes.csv", ec);  // from an earlier report of this folder
+  }
+  writeFileAtomic(r.out / "aggregate.csv", aggregateCsv(aggregate));
   writeFileAtomic(r.out / "table2.md", r.markdown);
   if (!job.no_plots) r.figures_failed = reportFigures(sweep, groups, table, r.out, job);
   return r;

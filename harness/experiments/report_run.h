@@ -1,9 +1,11 @@
 #pragma once
 // The `tgnav report` job: a sweep folder aggregated into the paper's Table II (table2.csv,
-// table2.md) and its figures (fig3_<scene> trajectories over the map, fig4_<scene> VO error
-// against distance travelled, plan_time), drawn by scripts/tgnav_plots.py from report.json and
-// the scenes' map images. Bad input (not a sweep, a malformed index) is refused before anything is
-// written; when the figures fail the tables are still there.
+// table2.md), the generalisation tables (report_scenes.h: scenes.csv, aggregate.csv and their
+// sections of table2.md) and the figures (fig3_<scene> trajectories over the map, fig4_<scene> VO
+// error against distance travelled, tracking_<scene> features and inliers per trial, plan_time,
+// calibration), drawn by scripts/tgnav_plots.py from report.json and the scenes' map images. Bad
+// input (not a sweep, a malformed index) is refused before anything is written; when the figures
+// fail the tables are still there.
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -30,7 +32,8 @@ SceneBackground sceneBackground(const std::string& scene, const std::filesystem:
                                 const std::filesystem::path& report_dir, const std::string& map_cache);
 
 // report.json: what the report figures (scripts/tgnav_plots.py report) need (groups with their trials' absolute
-// folders, statuses and VO-lost positions; per scene the background image and its extent).
+// folders, statuses, VO-lost positions, oracle and chosen classes, c_p_threshold and the VO's
+// min_inliers from config.yaml; per scene the background image and its extent).
 nlohmann::json reportJson(const SweepIndex& sweep, const std::vector<ReportGroup>& groups,
                           const std::vector<TableRow>& table, const std::vector<SceneBackground>& scenes);
 
@@ -45,7 +48,7 @@ struct ReportJob {
 
 struct ReportRunResult {
   std::filesystem::path out;
-  std::string markdown;  // table2.md
+  std::string markdown;  // table2.md (Table II and the generalisation sections)
   std::size_t groups = 0;
   std::size_t trials = 0;
   std::string figures_failed;  // why the figures are missing, or ""

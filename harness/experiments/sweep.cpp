@@ -11,6 +11,7 @@
 #include "harness/base/shell.h"
 #include "harness/config/scenario.h"
 #include "harness/config/yaml_util.h"
+#include "harness/experiments/sweep_scenes.h"
 #include "harness/run/plan_run.h"
 
 namespace tgnav::harness {
@@ -211,16 +212,18 @@ std::vector<int> readSamples(const YamlDoc& doc, const YAML::Node& run, const st
 
 // runs[r]; `seeds` are the sweep's, for a run that gives none.
 Run readRun(const YamlDoc& doc, const YAML::Node& run, std::size_t r, const fs::path& source,
-            const std::vector<std::uint64_t>& seeds) {
+            const std::vector<std::uint64_t>& seeds, const fs::path& scenes_dir) {
   Run out;
   out.context = "runs[" + std::to_string(r) + "]";
   const std::string& context = out.context;
   if (!run.IsMap()) doc.fail(run, context + ": expected a mapping (scenario, planner, ...)");
-  doc.requireKeys(run, {"scenario", "planner", "samples", "seeds", "set", "axes"}, context);
-  for (const char* key : {"scenario", "planner"}) {
-    if (!run[key]) doc.fail(run, context + ": key '" + key + "' is missing");
+  doc.requireKeys(run, {"scenario", "generated", "planner", "samples", "seeds", "set", "axes"}, context);
+  if (!run["planner"]) doc.fail(run, context + ": key 'planner' is missing");
+  if (static_cast<bool>(run["scenario"]) == static_cast<bool>(run["generated"])) {
+    doc.fail(run, context + ": give either 'scenario' (files) or 'generated' (generated scenes)");
   }
-  out.scenarios = readScenarios(doc, run, context, source);
+  out.scenarios =
+      run["scenario"] ? readScenarios(doc, run, context, source) : readGeneratedScenes(doc, run, context, scenes_dir);
   out.planners = readPlanners(doc, run, context);
   out.samples = readSamples(doc, run, context, out.planners);
   out.seeds = run["seeds"] ? readSeeds(doc, run["seeds"], joinKey(context, "seeds")) : seeds;
@@ -314,7 +317,7 @@ void assignIds(const YamlDoc& doc, const YAML::Node& runs, std::vector<SweepTria
 
 }  // namespace
 
-Sweep loadSweep(const fs::path& yaml) {
+Sweep loadSweep(const fs::path& yaml, const fs::path& scenes_dir) {
   const YamlDoc doc = YamlDoc::load(yaml);
   const YAML::Node& root = doc.root();
   if (!root.IsMap()) doc.fail(root, "a sweep file is a mapping with 'runs'");
@@ -332,7 +335,7 @@ Sweep loadSweep(const fs::path& yaml) {
   sweep.source = fs::absolute(yaml).lexically_normal();
   std::map<std::string, Checked> checked;  // by scenario and settings
   for (std::size_t r = 0; r < runs.size(); ++r) {
-    const Run run = readRun(doc, runs[r], r, sweep.source, seeds);
+    const Run run = readRun(doc, runs[r], r, sweep.source, seeds, scenes_dir);
     expandRun(doc, runs[r], run, common.fixed, &checked, &sweep);
   }
   assignIds(doc, runs, &sweep.trials);

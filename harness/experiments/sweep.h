@@ -14,6 +14,8 @@
 //       samples: [300, 1000, 2000]               # rrtstar's sample budget (rrtstar only)
 //       set: {vo.min_inliers: 25}                # optional: fixed overrides of this run
 //       axes: {vo.max_features: [300, 600]}      # optional: any config key, one value each
+//     - generated: {kind: room, seeds: [101, 102]}  # instead of scenario: generated scenes, written
+//       planner: proposed                           # into DIR/scenes/ (harness/experiments/sweep_scenes.h)
 //
 // A trial's id names what distinguishes it, e.g. storage__rrtstar-300__s01 or
 // storage__proposed__vo.max_features=300__s01; its results go to DIR/trials/<id>.
@@ -26,6 +28,7 @@
 //                  from the trial folders, so it never loses or repeats a trial
 //   trials/<id>/   one `tgnav trial` folder each; finished when it holds a valid metrics.json
 //   logs/<id>.log  each trial's output
+//   scenes/        generated scenes (runs with `generated:`), one folder each
 //   slurm/         job scripts and submitted job ids (--backend slurm)
 //   corrupt/       trial folders that were found corrupted, moved aside before re-running
 //
@@ -61,8 +64,10 @@ struct Sweep {
 };
 
 // Reads and expands a sweep file, and checks every trial's configuration (scenario, planner,
-// every --set key) by loading it. InputError naming file:line, the key and the value.
-Sweep loadSweep(const std::filesystem::path& yaml);
+// every --set key) by loading it. InputError naming file:line, the key and the value. Generated
+// scenes are written into (or checked against) `scenes_dir`, the sweep folder's scenes/; a sweep
+// file with generated scenes and no scenes_dir is an InputError.
+Sweep loadSweep(const std::filesystem::path& yaml, const std::filesystem::path& scenes_dir = {});
 
 // The arguments of `tgnav trial` for one trial (without the program), writing into `out`.
 std::vector<std::string> trialArguments(const SweepTrial& trial, const std::filesystem::path& out);

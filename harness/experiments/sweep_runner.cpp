@@ -30,15 +30,23 @@ void checkOptions(const SweepOptions& opt) {
   }
 }
 
-// DIR is new, empty, or a sweep folder; then it exists.
-void makeSweepFolder(const SweepDir& dir) {
+// True when DIR holds nothing but the generated scenes of a sweep that stopped at a bad sweep file.
+bool onlyScenes(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (e.path().filename() != "scenes") return false;
+  }
+  return !ec;
+}
+
+// DIR is new, empty, or a sweep folder (or holds only its generated scenes); InputError otherwise.
+void checkSweepFolder(const SweepDir& dir) {
   if (fs::exists(dir.path()) && !fs::is_directory(dir.path())) {
     throw InputError("--out: " + dir.path().string() + " exists and is not a directory");
   }
-  if (fs::exists(dir.path()) && !fs::is_empty(dir.path()) && !fs::exists(dir.path() / "commands.txt")) {
+  if (fs::exists(dir.path()) && !fs::exists(dir.path() / "commands.txt") && !onlyScenes(dir.path())) {
     throw InputError("--out: " + dir.path().string() + " holds files but no sweep; use a new or empty folder");
   }
-  makeOutputDir(dir.path());
 }
 
 fs::path selfExe() {
@@ -87,8 +95,10 @@ SweepRun planRun(const SweepDir& dir, const Sweep& sweep) {
 int runSweep(const SweepOptions& opt) {
   checkOptions(opt);
   const SweepDir dir(opt.out);
-  const Sweep sweep = loadSweep(opt.sweep);
-  makeSweepFolder(dir);
+  checkSweepFolder(dir);
+  // Generated scenes are written here (complete, each on its own) while the sweep file is checked.
+  const Sweep sweep = loadSweep(opt.sweep, fs::absolute(dir.path()) / "scenes");
+  makeOutputDir(dir.path());
   const FolderLock lock(dir.path() / ".lock", /*inherit=*/true, 120.0,
                         "tgnav sweep: " + dir.path().string() +
                             " is locked (another sweep, or the trials of a killed one still stopping); waiting...");

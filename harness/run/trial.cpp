@@ -300,6 +300,10 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   const TrialVerdict verdict = decideStatus(closed_loop.fly(progress, interrupt));
   result.status = verdict.status;
   result.detail = verdict.detail;
+  const planner::PerceptionPlannerConfig& model = scenario.planner.perception;
+  for (TrialFrame& f : result.frames) {
+    f.predicted = predictFrame(*result.plan.voxels, f.X_WC_true, model.visibility, model.information);
+  }
   return result;
 }
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "harness/config/scenario.h"
+#include "harness/run/frame_prediction.h"
 #include "harness/run/plan_run.h"
 #include "harness/run/trial_status.h"
 #include "harness/sim/flight_loop.h"
@@ -48,6 +49,7 @@ struct TrialProgress {
 struct TrialFrame {
   vo::FrameResult vo;  // status, counts, estimated pose
   Eigen::Isometry3d X_WC_true = Eigen::Isometry3d::Identity();
+  FramePrediction predicted;  // the planner's perception model at X_WC_true (frame_prediction.h)
   bool tracked() const { return vo.status != vo::TrackingStatus::kLost; }
 };
 

@@ -444,7 +444,7 @@ TEST(ReportCommand, DrawsTheFigures) {
     ASSERT_TRUE(fs::exists(dir / "report" / f)) << f;
     EXPECT_GT(fs::file_size(dir / "report" / f), 0u) << f;
   }
-  for (const char* f : {"map_smoke.png", "fig3_smoke.png", "fig4_smoke.png", "plan_time.png"}) {
+  for (const char* f : {"map_smoke.png", "fig3_smoke.png", "fig4_smoke.png", "tracking_smoke.png", "plan_time.png"}) {
     ASSERT_TRUE(fs::exists(dir / "report" / f)) << f;
     EXPECT_GT(fs::file_size(dir / "report" / f), 10000u) << f;  // a picture, not an empty canvas
   }
@@ -457,6 +457,13 @@ TEST(ReportCommand, DrawsTheFigures) {
   EXPECT_EQ(j["scenes"][0]["map"], "map_smoke.png");
   EXPECT_EQ(j["scenes"][0]["extent_m"][0], -4.0);
   EXPECT_EQ(j["scenes"][0]["extent_m"][3], 3.0);
+  EXPECT_EQ(j["groups"][1]["trials"][0]["min_inliers"], 30);  // the VO's default: config.yaml has no vo section
+  EXPECT_TRUE(j["groups"][1]["trials"][0]["oracle_class"].is_null());
+  // No vo.csv has the perception model's prediction: no calibration plot, and table2.md says so.
+  EXPECT_FALSE(fs::exists(dir / "report/calibration.png"));
+  EXPECT_NE(run.output.find("no calibration plot"), std::string::npos) << run.output;
+  EXPECT_TRUE(fs::exists(dir / "report/aggregate.csv"));
+  EXPECT_FALSE(fs::exists(dir / "report/scenes.csv"));  // one scene, no oracle trials
 }
 #endif
 

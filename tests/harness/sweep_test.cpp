@@ -34,6 +34,42 @@ fs::path sweepFile(const fs::path& dir, const std::string& body) {
   return test::writeFile(dir / "sweep.yaml", text);
 }
 
+TEST(Sweep, GeneratedScenesAreWrittenOnceAndCheckedOnEveryLoad) {
+  const fs::path dir = test::tempDir();
+  const fs::path file = sweepFile(dir,
+                                  "runs:\n"
+                                  "  - generated: [{kind: room, seeds: [5, 6]}, {kind: corridors, seeds: [5]}]\n"
+                                  "    planner: proposed\n"
+                                  "    seeds: [1]\n");
+  const fs::path scenes = dir / "out" / "scenes";
+  const Sweep s = loadSweep(file, scenes);
+  ASSERT_EQ(s.trials.size(), 3u);
+  EXPECT_EQ(s.trials[0].id, "room-5__proposed__s01");
+  EXPECT_EQ(s.trials[2].id, "corridors-5__proposed__s01");
+  EXPECT_EQ(s.trials[1].scenario, scenes / "room-6" / "scenarios" / "room-6.yaml");
+  EXPECT_EQ(s.trials[1].scene, "room-6");
+  // Loaded again: the same trials, the scenes checked, not rewritten.
+  const auto written = fs::last_write_time(scenes / "room-5" / "room-5.xml");
+  EXPECT_EQ(loadSweep(file, scenes).trials.size(), 3u);
+  EXPECT_EQ(fs::last_write_time(scenes / "room-5" / "room-5.xml"), written);
+  // A scene that is not what the generator writes is refused, naming the file.
+  test::writeFile(scenes / "room-6" / "scenes" / "room-6.yaml", "mjcf: ../room-6.xml\n");
+  EXPECT_NE(test::inputError([&] { loadSweep(file, scenes); }).find("room-6.yaml"), std::string::npos);
+  // Without a sweep folder, or with a bad kind or seed: one line naming the key.
+  EXPECT_NE(test::inputError([&] { loadSweep(file); }).find("runs[0].generated"), std::string::npos);
+  const fs::path bad_kind =
+      test::writeFile(dir / "k.yaml", "runs:\n  - {generated: {kind: cave, seeds: [1]}, planner: proposed}\n");
+  EXPECT_NE(test::inputError([&] { loadSweep(bad_kind, dir / "k"); }).find("cave"), std::string::npos);
+  const fs::path bad_seed =
+      test::writeFile(dir / "s.yaml", "runs:\n  - {generated: {kind: room, seeds: [-1]}, planner: proposed}\n");
+  EXPECT_NE(test::inputError([&] { loadSweep(bad_seed, dir / "s"); }).find("-1"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "k"));
+  EXPECT_FALSE(fs::exists(dir / "s"));
+  const fs::path both = test::writeFile(
+      dir / "b.yaml", "runs:\n  - {generated: {kind: room, seeds: [1]}, scenario: x.yaml, planner: proposed}\n");
+  EXPECT_NE(test::inputError([&] { loadSweep(both, dir / "b"); }).find("either"), std::string::npos);
+}
+
 TEST(Sweep, ExpandsRunsAsCartesianProductsInOrder) {
   const fs::path dir = test::tempDir();
   const Sweep s = loadSweep(sweepFile(dir,

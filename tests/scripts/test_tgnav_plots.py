@@ -34,7 +34,7 @@ FIGURES = {
     "trial": ["topdown", "ate"],
     "plan": ["plan"],
     "map": ["topdown"],
-    "report": ["fig3_synthetic", "fig4_synthetic", "plan_time"],
+    "report": ["fig3_synthetic", "fig4_synthetic", "tracking_synthetic", "plan_time"],
 }
 EXTENT = [-4.0, 4.0, -3.0, 3.0]
 EST_OFFSET_M = 0.1  # the VO estimate is the true path shifted in x: error 0.1 everywhere
@@ -456,6 +456,160 @@ class PlotsTest(unittest.TestCase):
         mean = line(fig4, "Proposed (1/2)")
         values = np.asarray(mean.get_ydata(), dtype=float)
         np.testing.assert_allclose(values[np.isfinite(values)], EST_OFFSET_M, atol=1e-5)
+
+
+# ---------------------------------------------------------------------------------------------
+# The report's tracking and calibration figures (vo.csv with the perception model's prediction)
+
+VO_HEADER = ["t", "status", "features", "with_depth", "matches", "inliers", "keyframe", "x_true", "y_true", "z_true",
+             "x_est", "y_est", "z_est", "predicted_score", "predicted_landmarks", "reason"]
+
+
+def write_vo(folder, inliers, lost_from=None, predicted=True, order=None):
+    """vo.csv of frames 0.1 m apart along x: `inliers` per frame, lost from frame `lost_from` on,
+    predicted_score = inliers / 10 and predicted_landmarks = 2 * inliers (when `predicted`),
+    columns in `order` (default VO_HEADER)."""
+    os.makedirs(folder, exist_ok=True)
+    header = [c for c in (order or VO_HEADER) if predicted or not c.startswith("predicted_")]
+    rows = []
+    for k, n in enumerate(inliers):
+        lost = lost_from is not None and k >= lost_from
+        cell = {"t": f"{0.1 * k:.3f}", "status": "lost" if lost else ("weak" if n < 60 else "ok"),
+                "features": str(n + 100), "with_depth": "0", "matches": "0", "inliers": str(n), "keyframe": "0",
+                "x_true": f"{0.1 * k:.3f}", "y_true": "0", "z_true": "1",
+                "x_est": "" if lost else f"{0.1 * k:.3f}", "y_est": "" if lost else "0", "z_est": "" if lost else "1",
+                "predicted_score": f"{n / 10:.2f}", "predicted_landmarks": str(2 * n),
+                "reason": f"{n} inliers < 30" if lost else ""}
+        rows.append(",".join(cell[c] for c in header))
+    write(folder, "vo.csv", ",".join(header) + "\n" + "\n".join(rows) + "\n")
+    return folder
+
+
+def write_generalisation_report(folder, trials, threshold=4.0, min_inliers=30):
+    """report.json of one scene, two groups: Proposed over trials[:-1], an oracle group over the last."""
+    os.makedirs(folder, exist_ok=True)
+
+    def trial(i, oracle=None):
+        status = "success" if i % 2 == 0 else "vo_lost"
+        return {"id": f"t{i}", "seed": i + 1, "folder": os.path.abspath(trials[i]), "status": status,
+                "vo_lost_position": None, "oracle_class": oracle, "c_p_threshold": threshold,
+                "min_inliers": min_inliers}
+    groups = [{"label": "Proposed", "scene": "synthetic", "successes": 1, "plan_time_s": None,
+               "trials": [trial(i) for i in range(len(trials) - 1)]},
+              {"label": "Proposed [planner.oracle_class=1]", "scene": "synthetic", "successes": 1,
+               "plan_time_s": None, "trials": [trial(len(trials) - 1, oracle=1)]}]
+    write_json(folder, "report.json", {"scenes": [{"name": "synthetic", "map": None}], "groups": groups})
+    return folder
+
+
+class ReportTrackingTest(unittest.TestCase):
+    def setUp(self):
+        self._tmp = tempfile.TemporaryDirectory()
+        self.tmp = self._tmp.name
+
+    def tearDown(self):
+        self._tmp.cleanup()
+
+    def folder(self, name):
+        return os.path.join(self.tmp, name)
+
+    def test_vo_csv_is_read_by_header_names_in_any_order(self):
+        shuffled = ["reason", "z_est", "inliers", "predicted_landmarks", "x_true", "status", "y_true", "z_true",
+                    "features", "x_est", "predicted_score", "y_est", "t", "keyframe"]
+        for order in (None, shuffled):
+            with self.subTest(order=order):
+                folder = write_vo(self.folder("v"), [200, 100, 50, 20, 10], lost_from=3, order=order)
+                f = tgnav_plots.read_vo_frames(os.path.join(folder, "vo.csv"))
+                np.testing.assert_allclose(f.distance, [0.0, 0.1, 0.2, 0.3, 0.4], atol=1e-9)
+                np.testing.assert_array_equal(f.inliers, [200, 100, 50, 20, 10])
+                np.testing.assert_array_equal(f.features, [300, 200, 150, 120, 110])
+                np.testing.assert_array_equal(f.tracking, [True, True, True, False, False])  # weak is tracking
+                np.testing.assert_allclose(f.predicted_score, [20.0, 10.0, 5.0, 2.0, 1.0])
+                np.testing.assert_array_equal(f.predicted_landmarks, [400, 200, 100, 40, 20])
+                self.assertTrue(np.isnan(f.error[3:]).all() and np.allclose(f.error[:3], 0.0))
+
+    def test_vo_csv_without_the_prediction_columns(self):
+        folder = write_vo(self.folder("v"), [200, 100], predicted=False)
+        f = tgnav_plots.read_vo_frames(os.path.join(folder, "vo.csv"))
+        self.assertIsNone(f.predicted_score)
+        self.assertIsNone(f.predicted_landmarks)
+        write(folder, "vo.csv", "t,status,features\n0,ok,3\n")
+        with self.assertRaisesRegex(tgnav_plots.DataError, "no column inliers, x_true"):
+            tgnav_plots.read_vo_frames(os.path.join(folder, "vo.csv"))
+        write(folder, "vo.csv", ",".join(VO_HEADER) + "\n" + ",".join(["0", "ok", "x"] + ["1"] * 13) + "\n")
+        with self.assertRaisesRegex(tgnav_plots.DataError, "line 2, column features: 'x' is not a number"):
+            tgnav_plots.read_vo_frames(os.path.join(folder, "vo.csv"))
+
+    def test_lost_stretches(self):
+        d = np.arange(6, dtype=float)
+        spans = tgnav_plots.lost_spans(d, np.array([True, False, False, True, True, False]))
+        self.assertEqual(spans, [(0.0, 3.0), (4.0, 5.0)])  # from the last tracked frame on
+
+    def make(self, predicted=True):
+        inliers = [[200, 150, 80, 45, 40, 90, 120], [200, 100, 40, 20, 10, 5, 5], [300, 250, 200, 150, 100, 80, 60]]
+        lost = [None, 3, None]
+        trials = [write_vo(self.folder(f"t{i}"), n, lost_from=lost[i], predicted=predicted)
+                  for i, n in enumerate(inliers)]
+        return write_generalisation_report(self.folder("report"), trials)
+
+    def test_tracking_panels_per_trial_mark_the_lost_frames(self):
+        figures = tgnav_plots.report_figures(self.make())
+        self.assertIn("tracking_synthetic", figures)
+        axes = [ax for ax in figures["tracking_synthetic"].axes if ax.axison]
+        self.assertEqual(len(axes), 3)  # 2 proposed, 1 oracle; the fourth panel is off
+        held, lost, oracle = axes
+        self.assertEqual([t.get_text() for t in held.texts], ["seed 1: success"])
+        self.assertEqual([t.get_text() for t in lost.texts], ["seed 2: vo_lost"])
+        self.assertEqual(held.get_xlim(), lost.get_xlim())  # the same scale in every panel
+        self.assertEqual(held.get_ylim(), oracle.get_ylim())
+        np.testing.assert_array_equal(line(held, "inliers").get_ydata(), [200, 150, 80, 45, 40, 90, 120])
+        np.testing.assert_allclose(line(held, "inliers").get_xdata(), np.arange(7) * 0.1, atol=1e-9)
+        # The faint stretch of the first trial held: no lost marker, no band; the second's is marked.
+        self.assertEqual([li.get_label() for li in held.get_lines() if li.get_label() == "lost frame"], [])
+        self.assertEqual(len(held.patches), 0)
+        np.testing.assert_allclose(line(lost, "lost frame").get_xdata(), [0.3, 0.4, 0.5, 0.6], atol=1e-9)
+        self.assertEqual(len(lost.patches), 1)
+        self.assertEqual(line(lost, "min. inliers").get_ydata()[0], 30)
+        self.assertIn("oracle_class=1", oracle.get_ylabel())
+
+    def test_calibration_plots_every_frame_against_the_threshold(self):
+        figures = tgnav_plots.report_figures(self.make())
+        score, landmarks = figures["calibration"].axes
+        tracking = [li for li in score.get_lines() if li.get_label().startswith("tracking")][0]
+        lost = [li for li in score.get_lines() if li.get_label().startswith("lost")][0]
+        self.assertEqual(len(tracking.get_xdata()) + len(lost.get_xdata()), 21)
+        np.testing.assert_allclose(sorted(lost.get_xdata()), [0.5, 0.5, 1.0, 2.0])  # inliers / 10
+        self.assertEqual(line(score, "$c_{p,thr}$").get_xdata()[0], 4.0)
+        self.assertEqual(line(score, "VO min. inliers").get_ydata()[0], 30)
+        self.assertEqual(sorted(landmarks.get_lines()[1].get_xdata())[:2], [10, 10])  # 2 * inliers of lost frames
+        self.assertIn("21 frames of 3 trials", figures["calibration"]._suptitle.get_text())
+
+    def test_no_calibration_without_predicted_score(self):
+        figures = tgnav_plots.report_figures(self.make(predicted=False))
+        self.assertNotIn("calibration", figures)
+        self.assertIn("tracking_synthetic", figures)
+        status, out, err = run_main("report", self.folder("report"))
+        self.assertEqual((status, out, err), (0, "", ""))
+        self.assertTrue(os.path.exists(os.path.join(self.folder("report"), "tracking_synthetic.png")))
+        self.assertFalse(os.path.exists(os.path.join(self.folder("report"), "calibration.png")))
+
+    def test_many_trials_wrap_into_rows(self):
+        trials = [tgnav_plots.ReportTrial("success", None, None, None, seed=k + 1) for k in range(23)]
+        group = tgnav_plots.ReportGroup("Proposed", "synthetic", 23, None, trials)
+        fig = tgnav_plots.tracking_figure(tgnav_plots.ReportScene("synthetic", None), [group])
+        shown = [ax for ax in fig.axes if ax.axison]
+        self.assertEqual(len(shown), 23)
+        self.assertEqual(len(fig.axes), 24)  # 3 rows of 8 (as even as 10 a row allows)
+
+    def test_reading_many_trials_is_fast(self):
+        import time
+        folder = write_vo(self.folder("big"), list(np.arange(1500) % 300))
+        path = os.path.join(folder, "vo.csv")
+        start = time.perf_counter()
+        for _ in range(100):
+            tgnav_plots.read_vo_frames(path)
+        # 100 trials of 1500 frames; 600 trials must stay well within a report's minute.
+        self.assertLess(time.perf_counter() - start, 10.0)
 
 
 if __name__ == "__main__":

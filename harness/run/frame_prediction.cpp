@@ -1,0 +1,23 @@
+#include "harness/run/frame_prediction.h"
+
+#include <cmath>
+
+namespace tgnav::harness {
+
+FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isometry3d& X_WC,
+                             const planner::VisibilityConfig& visibility,
+                             const planner::InformationConfig& information) {
+  const Eigen::Vector3d p = X_WC.translation();
+  const Eigen::Vector3d forward = X_WC.linear().col(2);
+  const double yaw = std::atan2(forward.y(), forward.x());
+  const std::vector<planner::WeightedPoint> points =
+      planner::aggregateByVoxel(voxels, voxels.visibleFrom(p, visibility));
+  double landmarks = 0.0;
+  const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &landmarks);
+  FramePrediction out;
+  out.score = planner::scoreInformation(info, landmarks, information);
+  out.landmarks = static_cast<int>(landmarks);
+  return out;
+}
+
+}  // namespace tgnav::harness

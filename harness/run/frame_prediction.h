@@ -1,0 +1,25 @@
+#pragma once
+// What the planner's perception model predicts for the camera poses a trial really flew, for
+// calibrating the model against the VO (vo.csv's predicted_* columns beside the VO's own counts).
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "planner/perception.h"
+#include "planner/voxel_map.h"
+
+namespace tgnav::harness {
+
+struct FramePrediction {
+  double score =
+      0.0;  // log det of the Fisher information of the landmarks in view (eq. 6, as the pose graph scores a node)
+  int landmarks = 0;  // map landmarks that count (in the field of view, range, line of sight and incidence limit)
+};
+
+// The model at the true camera pose X_WC (optical frame: z forward): position and the yaw of the
+// optical axis, all landmarks of the map in view (not only a segment's co-visible set, as the pose
+// graph uses: the camera sees what is there).
+FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isometry3d& X_WC,
+                             const planner::VisibilityConfig& visibility,
+                             const planner::InformationConfig& information);
+
+}  // namespace tgnav::harness
