@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Per-class score stability of the proposed planner over plan seeds (issue: robust selection).
 
 For each scenario, plans with `tgnav plan --planner proposed --seed S` for S = 1..N and reports,
@@ -20,7 +20,7 @@ import sys
 
 def plan(args, scenario, seed, out):
     cmd = [args.tgnav, "plan", "--scenario", scenario, "--planner", "proposed", "--seed", str(seed),
-           "--out", out, "--no-figures"]
+           "--out", out]
     if args.map_cache:
         cmd += ["--map-cache", args.map_cache]
     if os.path.exists(out):
