@@ -216,7 +216,7 @@ class ClosedLoop {
         result_->strip_captions.push_back(frameCaption(d.vo));
         result_->strip.push_back(d.image);
       }
-      result_->frames.push_back(TrialFrame{d.vo, d.X_WC_true});
+      result_->frames.push_back(TrialFrame{d.vo, d.X_WC_true, FramePrediction{}});
       if (lost && !result_->vo_lost) {
         result_->vo_lost = TrialEvent{d.vo.t_s, positionAt(result_->flight, d.vo.t_s), d.vo.reason};
       }
