@@ -212,7 +212,7 @@ std::vector<int> readSamples(const YamlDoc& doc, const YAML::Node& run, const st
 
 // runs[r]; `seeds` are the sweep's, for a run that gives none.
 Run readRun(const YamlDoc& doc, const YAML::Node& run, std::size_t r, const fs::path& source,
-            const std::vector<std::uint64_t>& seeds, const fs::path& scenes_dir) {
+            const std::vector<std::uint64_t>& seeds, GeneratedScenes* scenes) {
   Run out;
   out.context = "runs[" + std::to_string(r) + "]";
   const std::string& context = out.context;
@@ -223,7 +223,7 @@ Run readRun(const YamlDoc& doc, const YAML::Node& run, std::size_t r, const fs::
     doc.fail(run, context + ": give either 'scenario' (files) or 'generated' (generated scenes)");
   }
   out.scenarios =
-      run["scenario"] ? readScenarios(doc, run, context, source) : readGeneratedScenes(doc, run, context, scenes_dir);
+      run["scenario"] ? readScenarios(doc, run, context, source) : readGeneratedScenes(doc, run, context, scenes);
   out.planners = readPlanners(doc, run, context);
   out.samples = readSamples(doc, run, context, out.planners);
   out.seeds = run["seeds"] ? readSeeds(doc, run["seeds"], joinKey(context, "seeds")) : seeds;
@@ -334,8 +334,9 @@ Sweep loadSweep(const fs::path& yaml, const fs::path& scenes_dir) {
   Sweep sweep;
   sweep.source = fs::absolute(yaml).lexically_normal();
   std::map<std::string, Checked> checked;  // by scenario and settings
+  GeneratedScenes scenes{scenes_dir, {}};
   for (std::size_t r = 0; r < runs.size(); ++r) {
-    const Run run = readRun(doc, runs[r], r, sweep.source, seeds, scenes_dir);
+    const Run run = readRun(doc, runs[r], r, sweep.source, seeds, &scenes);
     expandRun(doc, runs[r], run, common.fixed, &checked, &sweep);
   }
   assignIds(doc, runs, &sweep.trials);

@@ -37,14 +37,18 @@ std::string firstDifference(const scenes::GeneratedScene& scene, const fs::path&
   return "";
 }
 
-// DIR/<kind>-<seed>: written when absent, checked when present. Returns its scenario file.
+// DIR/<kind>-<seed>: written when absent, checked when present (once per reading). Returns its
+// scenario file.
 fs::path ensureScene(const YamlDoc& doc, const YAML::Node& where, const std::string& key, SceneKind kind,
-                     std::uint64_t seed, const fs::path& scenes_dir) {
+                     std::uint64_t seed, GeneratedScenes* generated) {
+  const std::string name = scenes::sceneName(kind, seed);
+  const fs::path scenario = generated->dir / name / scenes::scenarioFile(kind, seed);
+  if (!generated->ensured.insert(name).second) return scenario;
   const scenes::GeneratedScene scene = scenes::generateScene(kind, seed);
-  const fs::path dir = scenes_dir / scenes::sceneName(kind, seed);
+  const fs::path dir = generated->dir / name;
   std::error_code ec;
   if (!fs::exists(dir, ec)) {
-    fs::create_directories(scenes_dir);
+    fs::create_directories(generated->dir);
     scenes::writeGeneratedScene(scene, dir);
   } else {
     const std::string differs = firstDifference(scene, dir);
@@ -55,16 +59,16 @@ fs::path ensureScene(const YamlDoc& doc, const YAML::Node& where, const std::str
                           "began it, or start a new sweep folder");
     }
   }
-  return dir / scenes::scenarioFile(kind, seed);
+  return scenario;
 }
 
 }  // namespace
 
 std::vector<fs::path> readGeneratedScenes(const YamlDoc& doc, const YAML::Node& run, const std::string& context,
-                                          const fs::path& scenes_dir) {
+                                          GeneratedScenes* generated) {
   const std::string key = joinKey(context, "generated");
   const YAML::Node node = run["generated"];
-  if (scenes_dir.empty()) {
+  if (generated->dir.empty()) {
     doc.fail(node, key + ": generated scenes are written into the sweep folder, and there is none here");
   }
   std::vector<fs::path> scenarios;
@@ -91,7 +95,7 @@ std::vector<fs::path> readGeneratedScenes(const YamlDoc& doc, const YAML::Node& 
       } catch (const InputError& e) {
         doc.fail(s, e.what());
       }
-      const fs::path scenario = ensureScene(doc, s, key, kind, seed, scenes_dir);
+      const fs::path scenario = ensureScene(doc, s, key, kind, seed, generated);
       if (std::find(scenarios.begin(), scenarios.end(), scenario) != scenarios.end()) {
         doc.fail(s, joinKey(key, "seeds") + ": " + scenes::sceneName(kind, seed) + " is listed twice");
       }
