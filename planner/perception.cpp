@@ -1,5 +1,6 @@
 #include "planner/perception.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -14,6 +15,27 @@ void InformationConfig::validate() const {
           "must be in (0, pi/2]");
   require(min_landmarks >= 0.0 && std::isfinite(min_landmarks), "min_landmarks", min_landmarks,
           "must be finite and >= 0");
+  require(min_image_coverage >= 0.0 && min_image_coverage <= 1.0, "min_image_coverage", min_image_coverage,
+          "must be in [0, 1]");
+}
+
+double ViewSupport::coverage() const {
+  return static_cast<double>(__builtin_popcountll(cells)) / (kImageCols * kImageRows);
+}
+
+int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
+              const VisibilityConfig& visibility) {
+  const Eigen::Vector3d d = l_W - p_W;
+  const double c = std::cos(yaw_rad);
+  const double s = std::sin(yaw_rad);
+  const double forward = c * d.x() + s * d.y();
+  const double left = -s * d.x() + c * d.y();
+  if (forward <= 0.0) return -1;
+  const double u = -left / forward / std::tan(0.5 * visibility.hfov_rad);   // -1 left edge, +1 right
+  const double v = -d.z() / forward / std::tan(0.5 * visibility.vfov_rad);  // -1 top, +1 bottom
+  const int col = std::clamp(static_cast<int>(std::floor(0.5 * (u + 1.0) * kImageCols)), 0, kImageCols - 1);
+  const int row = std::clamp(static_cast<int>(std::floor(0.5 * (v + 1.0) * kImageRows)), 0, kImageRows - 1);
+  return row * kImageCols + col;
 }
 
 bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, const InformationConfig& config) {
@@ -23,9 +45,10 @@ bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, con
   return range > 0.0 && point.normal_W.dot(to_camera) >= std::cos(config.max_incidence_rad) * range;
 }
 
-double scoreInformation(const Matrix6d& info, double landmarks, const InformationConfig& config) {
-  return landmarks < config.min_landmarks ? logDetInformation(Matrix6d::Zero(), config.epsilon)
-                                          : logDetInformation(info, config.epsilon);
+double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config) {
+  const bool blind = support.landmarks < config.min_landmarks ||
+                     (config.min_image_coverage > 0.0 && support.coverage() < config.min_image_coverage);
+  return blind ? logDetInformation(Matrix6d::Zero(), config.epsilon) : logDetInformation(info, config.epsilon);
 }
 
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
@@ -55,24 +78,24 @@ bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vect
 }
 
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
-                         const VisibilityConfig& visibility, const InformationConfig& config, double* landmarks) {
+                         const VisibilityConfig& visibility, const InformationConfig& config, ViewSupport* support) {
   Matrix6d info = Matrix6d::Zero();
-  double count = 0.0;
+  ViewSupport view;
   for (const WeightedPoint& pt : points) {
     if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
-      count += pt.weight;
+      view.add(pt.weight, imageCell(p_W, yaw_rad, pt.p_W, visibility));
     }
   }
-  if (landmarks != nullptr) *landmarks = count;
+  if (support != nullptr) *support = view;
   return info;
 }
 
 double poseScore(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                  const VisibilityConfig& visibility, const InformationConfig& config) {
-  double landmarks = 0.0;
-  const Matrix6d info = poseInformation(p_W, yaw_rad, points, visibility, config, &landmarks);
-  return scoreInformation(info, landmarks, config);
+  ViewSupport support;
+  const Matrix6d info = poseInformation(p_W, yaw_rad, points, visibility, config, &support);
+  return scoreInformation(info, support, config);
 }
 
 }  // namespace tgnav::planner

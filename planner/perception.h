@@ -10,6 +10,7 @@
 // bearings and information agree to a fraction of a percent, and the sums get 10-20x cheaper.
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "planner/feature_map.h"
@@ -29,6 +30,13 @@ struct InformationConfig {
   // of landmarks would be in theory. Calibrated against the VO (README: the perception model).
   double max_incidence_rad = M_PI / 2.0;  // pi/2: no limit
   double min_landmarks = 0.0;
+  // Image coverage (ours): the share of the image, cut into kImageCols x kImageRows cells, whose
+  // cells hold at least one landmark that counts. A pose below min_image_coverage scores as blind.
+  // The VO detects a fixed budget of features spread over the image, so what it can track follows
+  // how much of the image is textured, not how many landmarks the map holds there: a 0.5 m strip
+  // of textured wall at the edge of a view filled by a plain wall held 600 map landmarks while the
+  // VO found 80 features on it and was lost (generated room-1002). Calibrated against the VO.
+  double min_image_coverage = 0.2;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -37,6 +45,7 @@ struct InformationConfig {
     a("epsilon", epsilon);
     a("max_incidence_rad", max_incidence_rad);
     a("min_landmarks", min_landmarks);
+    a("min_image_coverage", min_image_coverage);
   }
 
   void validate() const;
@@ -52,9 +61,30 @@ struct WeightedPoint {
 // (always, where the normal is unknown).
 bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, const InformationConfig& config);
 
-// The score of a pose from its information and the weight of the landmarks behind it: log det
-// (I + eps Id), or the blind score 6 ln eps when fewer than config.min_landmarks count.
-double scoreInformation(const Matrix6d& info, double landmarks, const InformationConfig& config);
+// The image cells of InformationConfig::min_image_coverage.
+constexpr int kImageCols = 8;
+constexpr int kImageRows = 6;
+
+// What backs a pose's information: the landmarks that count and the image cells they fall in.
+struct ViewSupport {
+  double landmarks = 0.0;   // their summed weight
+  std::uint64_t cells = 0;  // bit row * kImageCols + col: a landmark falls in that cell
+  void add(double weight, int cell) {
+    landmarks += weight;
+    if (cell >= 0) cells |= std::uint64_t{1} << cell;
+  }
+  double coverage() const;  // share of the kImageCols x kImageRows cells marked
+};
+
+// The cell of a level pinhole camera's image at p_W looking along yaw_rad that l_W projects into
+// (the image spans the horizontal and vertical FoV; points outside are clamped to the border).
+int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
+              const VisibilityConfig& visibility);
+
+// The score of a pose from its information and what backs it: log det (I + eps Id), or the blind
+// score 6 ln eps when fewer than config.min_landmarks count or they cover less of the image than
+// config.min_image_coverage.
+double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config);
 
 // The candidate landmarks `ids` grouped by their voxel in `voxels`; ids outside its box are left out.
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids);
@@ -64,10 +94,10 @@ bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vect
                    const VisibilityConfig& visibility);
 
 // Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose that
-// are within the incidence limit; `landmarks` (optional): their summed weight.
+// are within the incidence limit; `support` (optional): their weight and image cells.
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                          const VisibilityConfig& visibility, const InformationConfig& config,
-                         double* landmarks = nullptr);
+                         ViewSupport* support = nullptr);
 // scoreInformation() of poseInformation(): log det (I + epsilon Id), the pose's term of eq. 8.
 double poseScore(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                  const VisibilityConfig& visibility, const InformationConfig& config);

@@ -78,10 +78,25 @@ std::vector<ScoredSegment> scoreSegments(const std::vector<PathSegment>& segment
   return out;
 }
 
+// Path length around the chosen poses that score blind (6 ln eps): each layer stands for half the
+// interval to either neighbour.
+double blindLength(const PoseGraphResult& graph, const InformationConfig& information) {
+  const double blind = logDetInformation(Matrix6d::Zero(), information.epsilon);
+  const std::size_t n = graph.scores.size();
+  double length = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (graph.scores[j] > blind + 1e-9) continue;
+    if (j > 0) length += 0.5 * (graph.layer_s[j] - graph.layer_s[j - 1]);
+    if (j + 1 < n) length += 0.5 * (graph.layer_s[j + 1] - graph.layer_s[j]);
+  }
+  return length;
+}
+
 // The config as the planners use it: one robot radius for the GVD slice and the pose graph.
 PerceptionPlannerConfig withRobotRadius(PerceptionPlannerConfig config) {
   config.topo.robot_radius_m = config.robot_radius_m;
   config.graph.robot_radius_m = config.robot_radius_m;
+  config.graph.turn_floor = config.selection.c_p_threshold;
   config.validate();
   return config;
 }
@@ -113,6 +128,8 @@ void SelectionConfig::validate() const {
   require(perception_weight >= 0.0, "selection.perception_weight", perception_weight, "must be >= 0");
   require(perception_tolerance >= 0.0 && std::isfinite(perception_tolerance), "selection.perception_tolerance",
           perception_tolerance, "must be finite and >= 0");
+  require(blind_tolerance_m >= 0.0 && std::isfinite(blind_tolerance_m), "selection.blind_tolerance_m",
+          blind_tolerance_m, "must be finite and >= 0");
 }
 
 void PerceptionPlannerConfig::validate() const {
@@ -136,17 +153,29 @@ double selectionCost(double length_m, double shortest_m, double c_p_min, const S
 int selectCandidate(std::vector<CandidatePath>& candidates, const SelectionConfig& config) {
   double shortest = std::numeric_limits<double>::infinity();
   double best_c_p_min = -std::numeric_limits<double>::infinity();
+  double least_blind = std::numeric_limits<double>::infinity();
   for (const CandidatePath& c : candidates) {
     if (!c.feasible) continue;
     shortest = std::min(shortest, c.length_m);
     best_c_p_min = std::max(best_c_p_min, c.c_p_min);
+    least_blind = std::min(least_blind, c.blind_length_m);
   }
   const bool perception_first = config.perception_first && best_c_p_min < config.c_p_threshold;
+  auto least_blind_ones = [&](const CandidatePath& c) {
+    return c.blind_length_m <= least_blind + config.blind_tolerance_m;
+  };
+  if (perception_first) {  // the best c_p,min among the classes with the least blind length
+    best_c_p_min = -std::numeric_limits<double>::infinity();
+    for (const CandidatePath& c : candidates) {
+      if (c.feasible && least_blind_ones(c)) best_c_p_min = std::max(best_c_p_min, c.c_p_min);
+    }
+  }
   int chosen = -1;
   for (std::size_t i = 0; i < candidates.size(); ++i) {
     CandidatePath& c = candidates[i];
     if (!c.feasible) continue;
     c.cost = selectionCost(c.length_m, shortest, c.c_p_min, config);
+    if (perception_first && !least_blind_ones(c)) continue;
     if (perception_first && c.c_p_min < best_c_p_min - config.perception_tolerance) continue;
     if (chosen < 0 || c.cost < candidates[static_cast<std::size_t>(chosen)].cost) chosen = static_cast<int>(i);
   }
@@ -169,9 +198,9 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
     detail.segments = extractSegments(
         path, config_.segments, [&](const Eigen::Vector3d& p) { return voxels_.visibleFrom(p, config_.visibility); },
         &detail.visibility_queries);
-    detail.graph =
-        searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information, config_.graph,
-                        config_.keep_start_yaw ? request.start.yaw_rad : std::nan(""), classSeed(request.seed, i));
+    detail.graph = searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information,
+                                   config_.graph, config_.keep_start_yaw ? request.start.yaw_rad : std::nan(""),
+                                   classSeed(request.seed, i), request.start.yaw_rad);
     CandidatePath& c = plan.candidates[i];
     c.feasible = detail.graph.found;
     c.segments = scoreSegments(detail.segments, detail.graph);
@@ -181,6 +210,7 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
     c.c_p = detail.graph.c_p;
     c.c_p_min = std::numeric_limits<double>::infinity();
     for (const ScoredSegment& s : c.segments) c.c_p_min = std::min(c.c_p_min, s.c_p);
+    c.blind_length_m = blindLength(detail.graph, config_.information);
   };
   tbb::task_arena arena(config_.threads > 0 ? config_.threads : tbb::task_arena::automatic);
   // One task per class, longest (slowest) first, so that the threads finish together.

@@ -20,9 +20,14 @@
 // c_p,min reaches c_p,thr, a class blind somewhere (c_p,min = 6 ln eps = -27.6) and a class with
 // weak but real information everywhere (c_p,min = 0.5) both pay ~eta_p and eq. 9 falls back to the
 // shortest, blind segment included; on a scene from outside the repository that lost the VO in
-// 4 of 5 trials. In that regime we rank by perception first: the classes whose c_p,min is within
-// perception_tolerance of the best one compete by eq. 9, the others are out. With some class at or
-// above c_p,thr, eq. 9 decides alone, as in the paper.
+// 4 of 5 trials. In that regime we rank by perception first: the classes with the least blind
+// length (path length around poses that score blind, within blind_tolerance_m of the least) stay;
+// of those, the classes whose c_p,min is within perception_tolerance of their best compete by
+// eq. 9, the others are out. The blind length comes first because a minimum is a poor summary:
+// with the image-coverage limit (perception.h) the gallery's start and goal score blind for a
+// pose or two in every class, and c_p,min = -27.6 everywhere could no longer tell a class blind
+// for 14 m from one blind for 0.6 m. With some class at or above c_p,thr, eq. 9 decides alone,
+// as in the paper.
 #include "planner/covisibility.h"
 #include "planner/perception.h"
 #include "planner/planner.h"
@@ -38,6 +43,7 @@ struct SelectionConfig {
   double perception_weight = 1.5;     // eta_p
   bool perception_first = true;       // below c_p,thr: rank by c_p,min first (ours, see above)
   double perception_tolerance = 1.0;  // c_p,min this close to the best counts as equal there
+  double blind_tolerance_m = 0.5;     // blind length this close to the least counts as equal there
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -47,6 +53,7 @@ struct SelectionConfig {
     a("perception_weight", perception_weight);
     a("perception_first", perception_first);
     a("perception_tolerance", perception_tolerance);
+    a("blind_tolerance_m", blind_tolerance_m);
   }
 
   void validate() const;
@@ -59,7 +66,7 @@ struct PerceptionPlannerConfig {
   VisibilityConfig visibility;
   InformationConfig information;
   SegmentConfig segments;
-  PoseGraphConfig graph;  // its robot_radius_m is replaced by the one above
+  PoseGraphConfig graph;  // its robot_radius_m and turn_floor are replaced by the one above and c_p,thr
   SelectionConfig selection;
   bool keep_start_yaw = false;  // false: the MAV may turn on the spot before it sets off,
                                 // so the first pose's yaw is searched like the others

@@ -35,8 +35,9 @@ struct CandidatePath {
   double length_m = 0.0;                                      // of `path`
   double c_p = std::numeric_limits<double>::quiet_NaN();      // eq. 8 over the whole path
   double c_p_min = std::numeric_limits<double>::quiet_NaN();  // eq. 10: weakest segment
-  double cost = std::numeric_limits<double>::quiet_NaN();     // selection cost (eq. 9) or planner's own
-  bool feasible = true;                                       // false: no collision-free 4-DoF path in this class
+  double blind_length_m = 0.0;  // path length around the poses that score blind (6 ln eps; proposed only)
+  double cost = std::numeric_limits<double>::quiet_NaN();  // selection cost (eq. 9) or planner's own
+  bool feasible = true;                                    // false: no collision-free 4-DoF path in this class
   std::vector<ScoredSegment> segments;
   std::vector<Pose4> path;
 };

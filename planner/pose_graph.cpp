@@ -26,6 +26,40 @@ void perpendicularBasis(const Eigen::Vector3d& tangent, Eigen::Vector3d* e1, Eig
   *e1 = up.cross(t).normalized();  // horizontal, to the left of the path
   *e2 = t.cross(*e1);              // "up" within the plane
 }
+// Which first-node yaws (yaw_of[k]; yaw_of[0] is the vehicle's own) the turn on the spot at
+// `start` may reach: every lattice yaw it sweeps after the vehicle's own, the shorter way round
+// (both ways for a half turn, which could go either way), scores at least `floor`. Not turning
+// is always allowed: the VO starts from the vehicle's own view whatever the model says of it.
+std::vector<bool> startTurnAllowed(const Eigen::Vector3d& start, const std::vector<double>& yaw_of,
+                                   const VoxelMap& voxels, const VisibilityConfig& visibility,
+                                   const InformationConfig& information, double floor) {
+  const int yaws = static_cast<int>(yaw_of.size());
+  const std::vector<WeightedPoint> points = aggregateByVoxel(voxels, voxels.visibleFrom(start, visibility));
+  std::vector<double> view(yaw_of.size());
+  for (int k = 0; k < yaws; ++k) {
+    ViewSupport support;
+    const Matrix6d info =
+        poseInformation(start, yaw_of[static_cast<std::size_t>(k)], points, visibility, information, &support);
+    view[static_cast<std::size_t>(k)] = scoreInformation(info, support, information);
+  }
+  const double need = floor;
+  const double kNoView = std::numeric_limits<double>::infinity();
+  std::vector<bool> ok(yaw_of.size(), false);
+  ok[0] = true;
+  double left = kNoView;
+  for (int k = 1; 2 * k <= yaws; ++k) {
+    left = std::min(left, view[static_cast<std::size_t>(k)]);
+    ok[static_cast<std::size_t>(k)] = left >= need;
+  }
+  double right = kNoView;
+  for (int k = yaws - 1; 2 * k >= yaws; --k) {
+    right = std::min(right, view[static_cast<std::size_t>(k)]);
+    const bool fine = right >= need;
+    ok[static_cast<std::size_t>(k)] = 2 * k == yaws ? ok[static_cast<std::size_t>(k)] && fine : fine;
+  }
+  return ok;
+}
+
 }  // namespace
 
 void PoseGraphConfig::validate() const {
@@ -85,7 +119,7 @@ DagPath shortestLayeredPath(const LayeredDag& dag) {
 PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const std::vector<PathSegment>& segments,
                                 const VoxelMap& voxels, const VisibilityConfig& visibility,
                                 const InformationConfig& information, const PoseGraphConfig& config,
-                                double start_yaw_rad, std::uint64_t seed) {
+                                double start_yaw_rad, std::uint64_t seed, double turn_from_yaw_rad) {
   PoseGraphResult result;
   const double length = polylineLength3(path);
   const double spacing_max = config.nominal_speed_mps * config.time_step_s;
@@ -94,7 +128,8 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const double spacing = length / intervals;
   const int yaws = config.yaw_samples;
   const double yaw_step = 2.0 * M_PI / yaws;
-  const double yaw0 = std::isnan(start_yaw_rad) ? 0.0 : start_yaw_rad;
+  const bool free_start = std::isnan(start_yaw_rad);
+  const double yaw0 = !free_start ? start_yaw_rad : std::isnan(turn_from_yaw_rad) ? 0.0 : turn_from_yaw_rad;
   // Every layer is one time step Ts (layers are at most v_nom * Ts apart): the yaw may change by
   // up to yaw_rate_limit * Ts between layers, at least one yaw interval by validate().
   const int max_yaw_steps =
@@ -120,6 +155,10 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const int half_window = static_cast<int>(std::ceil(0.5 * visibility.hfov_rad / yaw_step)) + 1;
   std::vector<double> yaw_of(static_cast<std::size_t>(yaws));
   for (int k = 0; k < yaws; ++k) yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
+  const std::vector<bool> turn_ok =
+      free_start && !std::isnan(turn_from_yaw_rad) && config.guard_start_turn && !path.empty()
+          ? startTurnAllowed(path.front(), yaw_of, voxels, visibility, information, config.turn_floor)
+          : std::vector<bool>(static_cast<std::size_t>(yaws), true);
 
   for (int j = 0; j < layers; ++j) {
     const double s = j == layers - 1 ? length : spacing * j;
@@ -153,23 +192,24 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     auto& layer_positions = positions[static_cast<std::size_t>(j)];
     auto& layer_cost = dag.node_cost[static_cast<std::size_t>(j)];
     auto& layer_scores = scores[static_cast<std::size_t>(j)];
+    // What the camera sees around this layer (V of the path point, any yaw): the image coverage
+    // of InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
+    const bool gate = information.min_image_coverage > 0.0;
+    const std::vector<WeightedPoint> seen =
+        gate ? aggregateByVoxel(voxels, voxels.visibleFrom(centre, visibility)) : std::vector<WeightedPoint>{};
     for (const Eigen::Vector3d& p : candidates) {
       if (voxels.clearance(p) < config.robot_radius_m) continue;
       layer_positions.push_back(p);
-      // Information per yaw: each landmark adds to the yaws whose horizontal FoV holds it.
-      std::vector<Matrix6d> info(static_cast<std::size_t>(yaws), Matrix6d::Zero());
-      std::vector<double> count(static_cast<std::size_t>(yaws), 0.0);
-      for (const WeightedPoint& pt : points) {
+      // Calls add(yaw index, d) for each yaw whose field of view holds pt (range, vertical and
+      // horizontal FoV, incidence); only yaws near its azimuth can (all of them when the FoV is
+      // wide compared to the yaw grid).
+      auto forYawsHolding = [&](const WeightedPoint& pt, auto&& add) {
         const Eigen::Vector3d d = pt.p_W - p;
         const double range = d.norm();
-        if (range < visibility.min_range_m || range > visibility.max_range_m) continue;
-        if (!withinIncidence(p, pt, information)) continue;
-        if (std::atan2(std::abs(d.z()), d.head<2>().norm()) > 0.5 * visibility.vfov_rad) continue;
+        if (range < visibility.min_range_m || range > visibility.max_range_m) return;
+        if (!withinIncidence(p, pt, information)) return;
+        if (std::atan2(std::abs(d.z()), d.head<2>().norm()) > 0.5 * visibility.vfov_rad) return;
         const double azimuth = std::atan2(d.y(), d.x());
-        Matrix6d contribution = Matrix6d::Zero();
-        addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
-        // Only yaws near the landmark's azimuth can hold it (all of them when the FoV is wide
-        // compared to the yaw grid).
         const bool all = 2 * half_window + 1 >= yaws;
         const int nearest = all ? 0 : static_cast<int>(std::lround((azimuth - yaw0) / yaw_step));
         const int first = all ? 0 : nearest - half_window;
@@ -177,15 +217,31 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         for (int k = first; k <= last; ++k) {
           const int idx = ((k % yaws) + yaws) % yaws;
           if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
-            info[static_cast<std::size_t>(idx)] += contribution;
-            count[static_cast<std::size_t>(idx)] += pt.weight;
+            add(static_cast<std::size_t>(idx));
           }
         }
+      };
+      // Information per yaw from the segment's co-visible landmarks (eq. 6).
+      std::vector<Matrix6d> info(static_cast<std::size_t>(yaws), Matrix6d::Zero());
+      std::vector<ViewSupport> support(static_cast<std::size_t>(yaws));
+      for (const WeightedPoint& pt : points) {
+        Matrix6d contribution = Matrix6d::Zero();
+        bool computed = false;
+        forYawsHolding(pt, [&](std::size_t idx) {
+          if (!computed) addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
+          computed = true;
+          info[idx] += contribution;
+          support[idx].add(pt.weight, -1);
+        });
+      }
+      for (const WeightedPoint& pt : seen) {
+        forYawsHolding(pt,
+                       [&](std::size_t idx) { support[idx].add(0.0, imageCell(p, yaw_of[idx], pt.p_W, visibility)); });
       }
       for (int k = 0; k < yaws; ++k) {
         const double score =
-            scoreInformation(info[static_cast<std::size_t>(k)], count[static_cast<std::size_t>(k)], information);
-        const bool allowed = !(j == 0 && !std::isnan(start_yaw_rad) && k != 0);
+            scoreInformation(info[static_cast<std::size_t>(k)], support[static_cast<std::size_t>(k)], information);
+        const bool allowed = j != 0 || (free_start ? turn_ok[static_cast<std::size_t>(k)] : k == 0);
         layer_scores.push_back(score);
         layer_cost.push_back(allowed ? -config.perception_weight * score / layers : kInf);
       }

@@ -203,7 +203,8 @@ class CovisibilityScorer {
     const View& b = view(s2);
     const Eigen::Vector3d p2 = position(s2, z_);
     Matrix6d info = Matrix6d::Zero();
-    double landmarks = 0.0;
+    ViewSupport support;
+    const double yaw2 = s2->as<Se2State>()->getYaw();
     std::size_t i = 0;
     std::size_t j = 0;
     while (i < a.slots.size() && j < b.slots.size()) {
@@ -215,12 +216,19 @@ class CovisibilityScorer {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
         addCentredInformation(p2, l.mean_W, static_cast<double>(l.ids.size()), config_.information.bearing_noise_rad,
                               &info);
-        landmarks += static_cast<double>(l.ids.size());
+        support.add(static_cast<double>(l.ids.size()), -1);
         ++i;
         ++j;
       }
     }
-    return scoreInformation(info, landmarks, config_.information);
+    // The image coverage is the camera's at s2: all of its view, not only the common part.
+    if (config_.information.min_image_coverage > 0.0) {
+      for (int slot : b.slots) {
+        support.add(0.0, imageCell(p2, yaw2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W,
+                                   config_.visibility));
+      }
+    }
+    return scoreInformation(info, support, config_.information);
   }
 
   // Cost per metre of an edge with score c: lambda_d + lambda_p f(c - c_p,thr) (eq. 9's sigmoid:

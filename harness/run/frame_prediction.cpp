@@ -12,11 +12,12 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   const double yaw = std::atan2(forward.y(), forward.x());
   const std::vector<planner::WeightedPoint> points =
       planner::aggregateByVoxel(voxels, voxels.visibleFrom(p, visibility));
-  double landmarks = 0.0;
-  const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &landmarks);
+  planner::ViewSupport support;
+  const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &support);
   FramePrediction out;
-  out.score = planner::scoreInformation(info, landmarks, information);
-  out.landmarks = static_cast<int>(landmarks);
+  out.score = planner::scoreInformation(info, support, information);
+  out.landmarks = static_cast<int>(support.landmarks);
+  out.coverage = support.coverage();
   return out;
 }
 

@@ -154,6 +154,7 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
     cj["length_m"] = c.length_m;
     cj["c_p"] = number(c.c_p);
     cj["c_p_min"] = number(c.c_p_min);
+    cj["blind_length_m"] = number(c.blind_length_m);
     cj["cost"] = number(c.cost);
     if (i < run.plan.details.size()) cj["visibility_queries"] = run.plan.details[i].visibility_queries;
     cj["segments"] = nlohmann::json::array();

@@ -62,7 +62,7 @@ std::string voCsv(const TrialResult& r) {
   out.precision(6);
   out << std::fixed;
   out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
-         "predicted_score,predicted_landmarks,reason\n";
+         "predicted_score,predicted_landmarks,predicted_coverage,reason\n";
   for (const TrialFrame& f : r.frames) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
     const Eigen::Vector3d e = f.vo.X_WC.translation();
@@ -74,7 +74,7 @@ std::string voCsv(const TrialResult& r) {
     } else {
       out << ",,";
     }
-    out << ',' << f.predicted.score << ',' << f.predicted.landmarks;
+    out << ',' << f.predicted.score << ',' << f.predicted.landmarks << ',' << f.predicted.coverage;
     std::string reason = f.vo.reason;
     for (char& c : reason) c = (c == ',' || c == '\n') ? ';' : c;
     out << ',' << reason << '\n';

@@ -87,6 +87,22 @@ TEST(SelectCandidate, BelowTheThresholdPerceptionComesFirst) {
   std::vector<CandidatePath> above{candidate(100.0, 30.0), candidate(14.0, 5.9)};
   EXPECT_EQ(selectCandidate(above, config), 1);
   EXPECT_EQ(selectCandidate(above, paper), 1);
+  // Every class blind somewhere (c_p,min ties at the blind score): the least blind length decides,
+  // within blind_tolerance_m (0.5), then eq. 9 (the shorter of the two least blind).
+  auto blind_for = [&](double length_m, double blind_m) {
+    CandidatePath c = candidate(length_m, blind);
+    c.blind_length_m = blind_m;
+    return c;
+  };
+  std::vector<CandidatePath> masked{blind_for(14.0, 14.0), blind_for(17.0, 0.6), blind_for(16.0, 0.8),
+                                    blind_for(15.0, 1.4)};
+  EXPECT_EQ(selectCandidate(masked, config), 2);
+  EXPECT_EQ(selectCandidate(masked, paper), 0);
+  // Blind lengths within the tolerance count as equal: c_p,min decides between them.
+  std::vector<CandidatePath> mixed{blind_for(14.0, 0.0), blind_for(15.0, 0.3)};
+  mixed[0].c_p_min = -20.0;
+  mixed[1].c_p_min = 3.0;
+  EXPECT_EQ(selectCandidate(mixed, config), 1);
   // Infeasible candidates are never chosen; none feasible: -1.
   std::vector<CandidatePath> none{candidate(10.0, 20.0)};
   none[0].feasible = false;
@@ -208,6 +224,10 @@ const Scene& sceneC() {
 PerceptionPlannerConfig plannerConfig() {
   PerceptionPlannerConfig c;
   c.topo.max_length_ratio = 20.0;  // keep the long class in the search
+  // The paper's perception model: these scenes test eq. 9, and their textured faces are a grid of
+  // landmarks 0.1 m apart that covers part of the image only (ImageCoverage tests the limit).
+  c.information.min_image_coverage = 0.0;
+  c.graph.guard_start_turn = false;  // and the paper's free start yaw (StartTurnNeverSweepsABlindView tests the guard)
   return c;
 }
 

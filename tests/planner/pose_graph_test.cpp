@@ -314,7 +314,8 @@ TEST(PoseGraph, WithoutPerceptionThePathIsTheReferenceLine) {
 TEST(PoseGraph, ChosenScoresMatchPoseScore) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;
-  const InformationConfig info;
+  InformationConfig info;
+  info.min_image_coverage = 0.0;  // information alone (the coverage limit: ImageCoverageGatesOnWhatTheCameraSees)
   const std::vector<PathSegment> segments =
       extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
   int checked = 0;
@@ -340,6 +341,101 @@ TEST(PoseGraph, ChosenScoresMatchPoseScore) {
 // layers, on any path length. Regression: the allowed turn used to scale with the layer spacing
 // (length / ceil(length / (v_nom Ts))), which froze the yaw on paths whose spacing fell short.
 // Measured by the edge count against a graph whose yaw is frozen (rate limit ~0).
+// The turn on the spot at the start (guard_start_turn): two textured panels face each other
+// across the start, 2.5 m to either side of a path along +x; the one behind the vehicle's yaw (-y)
+// is denser, so the unguarded search turns the MAV half round to it, sweeping the blind views
+// along the path. Guarded, every view the turn sweeps (the shorter way, on the yaw lattice)
+// scores at least c_p,thr.
+TEST(PoseGraph, StartTurnNeverSweepsABlindView) {
+  testing::SyntheticWorld w;
+  w.min_W = {0.0, 1.5, 0.0};
+  w.max_W = {9.0, 8.5, 2.5};
+  const Eigen::AlignedBox3d a(Eigen::Vector3d(2.0, 7.5, 0.0), Eigen::Vector3d(4.0, 7.8, 2.5));
+  const Eigen::AlignedBox3d b(Eigen::Vector3d(2.0, 2.2, 0.0), Eigen::Vector3d(4.0, 2.5, 2.5));
+  w.solids = {a, b};
+  w.texture(a, Eigen::Vector3d(0, -1, 0), 0.2);
+  w.texture(b, Eigen::Vector3d(0, 1, 0), 0.07);
+  const FeatureMap map = w.build();
+  const VoxelMap voxels(map, w.min_W, w.max_W);
+  const std::vector<Eigen::Vector3d> path = {{3.0, 5.0, kZ}, {7.0, 5.0, kZ}};
+  const VisibilityConfig vis;
+  const InformationConfig info;
+  const std::vector<PathSegment> segments =
+      extractSegments(path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleFrom(p, vis); });
+  const std::vector<WeightedPoint> from_start = aggregateByVoxel(voxels, voxels.visibleFrom(path.front(), vis));
+  auto view = [&](double yaw) { return poseScore(path.front(), yaw, from_start, vis, info); };
+  const double vehicle_yaw = M_PI / 2;
+  const double floor = 6.0;
+  ASSERT_GE(view(vehicle_yaw), floor);  // facing panel A
+  ASSERT_LT(view(0.0), floor);          // along the path: neither panel in the FoV
+  ASSERT_LT(view(M_PI), floor);
+  // The weakest view the turn from the vehicle's yaw to `yaw` sweeps, the shorter way round.
+  auto weakest_turn = [&](double yaw) {
+    const double step = 2.0 * M_PI / PoseGraphConfig{}.yaw_samples;
+    const double turn = wrap(yaw - vehicle_yaw);
+    const int steps = static_cast<int>(std::lround(std::abs(turn) / step));
+    double weakest = view(vehicle_yaw);
+    for (int k = 1; k <= steps; ++k) weakest = std::min(weakest, view(vehicle_yaw + std::copysign(k * step, turn)));
+    return weakest;
+  };
+
+  PoseGraphConfig unguarded;
+  unguarded.guard_start_turn = false;
+  const PoseGraphResult u = searchPoseGraph(path, segments, voxels, vis, info, unguarded, std::nan(""), 1, vehicle_yaw);
+  ASSERT_TRUE(u.found);
+  EXPECT_LT(std::sin(u.path.front().yaw_rad), 0.0) << "the denser panel B should win unguarded";
+  EXPECT_LT(weakest_turn(u.path.front().yaw_rad), floor);
+
+  PoseGraphConfig guarded;
+  guarded.turn_floor = floor;
+  const PoseGraphResult g = searchPoseGraph(path, segments, voxels, vis, info, guarded, std::nan(""), 1, vehicle_yaw);
+  ASSERT_TRUE(g.found);
+  EXPECT_GE(weakest_turn(g.path.front().yaw_rad), floor) << "first yaw " << g.path.front().yaw_rad;
+  EXPECT_GT(std::sin(g.path.front().yaw_rad), 0.0);
+  // Without the vehicle's yaw there is nothing to guard: the same answer as unguarded.
+  const PoseGraphResult n = searchPoseGraph(path, segments, voxels, vis, info, guarded, std::nan(""), 1);
+  ASSERT_TRUE(n.found);
+  std::cout << "[ figure   ] first yaw unguarded " << u.path.front().yaw_rad << " rad (turn sweeps "
+            << weakest_turn(u.path.front().yaw_rad) << "), guarded " << g.path.front().yaw_rad << " rad (turn sweeps "
+            << weakest_turn(g.path.front().yaw_rad) << "); c_p " << u.c_p << " -> " << g.c_p << "\n";
+}
+
+// With min_image_coverage, a chosen node scores its co-visible information where the camera's
+// view (the landmarks visible from the layer's path point) covers enough of the image, and blind
+// where it does not.
+TEST(PoseGraph, ImageCoverageGatesOnWhatTheCameraSees) {
+  const Corridor& c = texturedCorridor(+1);
+  const VisibilityConfig vis;
+  InformationConfig info;
+  info.min_image_coverage = 0.3;
+  const std::vector<PathSegment> segments =
+      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, 0.0, 5);
+  ASSERT_TRUE(r.found);
+  const double blind = 6.0 * std::log(info.epsilon);
+  InformationConfig ungated = info;
+  ungated.min_image_coverage = 0.0;
+  int gated = 0;
+  for (std::size_t j = 0; j < r.path.size(); ++j) {
+    const std::vector<WeightedPoint> seen =
+        aggregateByVoxel(c.voxels, c.voxels.visibleFrom(pointAt(c.path, r.layer_s[j]), vis));
+    ViewSupport support;
+    poseInformation(r.path[j].p_WB, r.path[j].yaw_rad, seen, vis, info, &support);
+    const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
+    const double direct =
+        poseScore(r.path[j].p_WB, r.path[j].yaw_rad, aggregateByVoxel(c.voxels, seg.covisible), vis, ungated);
+    if (support.coverage() < info.min_image_coverage) {
+      EXPECT_DOUBLE_EQ(r.scores[j], blind) << "layer " << j;
+      ++gated;
+    } else {
+      EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct))) << "layer " << j;
+    }
+  }
+  // The first pose is held at yaw 0 along the corridor: its textured wall fills the left of the image only.
+  std::cout << "[ figure   ] corridor, min_image_coverage 0.3: " << gated << " of " << r.path.size()
+            << " chosen poses gated blind\n";
+}
+
 TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;

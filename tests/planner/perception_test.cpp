@@ -1,0 +1,85 @@
+// The perception model's trackability terms (planner/perception.h): where a landmark falls in the
+// image, the image coverage of a view, and the blind score below min_landmarks or
+// min_image_coverage; the incidence limit.
+#include "planner/perception.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace tgnav::planner {
+namespace {
+
+// A wall 2 m in front of a camera at the origin looking along +x (yaw 0), landmarks on a grid
+// over y in [y0, y1], z in [-0.9, 0.9] (the camera's height is 0).
+std::vector<WeightedPoint> wall(double y0, double y1, double spacing) {
+  std::vector<WeightedPoint> points;
+  for (double y = y0; y <= y1 + 1e-9; y += spacing) {
+    for (double z = -0.9; z <= 0.9 + 1e-9; z += spacing) points.push_back({{2.0, y, z}, 1.0, {-1.0, 0.0, 0.0}});
+  }
+  return points;
+}
+
+TEST(ImageCell, CornersCentreAndSidesOfTheImage) {
+  const VisibilityConfig vis;
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  const double tx = std::tan(0.5 * vis.hfov_rad);
+  const double tz = std::tan(0.5 * vis.vfov_rad);
+  // Just inside the four corners: left is +y (the image's left column), up is +z (the top row).
+  EXPECT_EQ(imageCell(o, 0.0, {1.0, 0.99 * tx, 0.99 * tz}, vis), 0);
+  EXPECT_EQ(imageCell(o, 0.0, {1.0, -0.99 * tx, 0.99 * tz}, vis), kImageCols - 1);
+  EXPECT_EQ(imageCell(o, 0.0, {1.0, 0.99 * tx, -0.99 * tz}, vis), (kImageRows - 1) * kImageCols);
+  EXPECT_EQ(imageCell(o, 0.0, {1.0, -0.99 * tx, -0.99 * tz}, vis), kImageRows * kImageCols - 1);
+  // Turning the camera turns the image: just right of and above the centre of yaw pi/2 (right is -x).
+  EXPECT_EQ(imageCell(o, M_PI / 2, {0.01, 3.0, 0.01}, vis), (kImageRows / 2 - 1) * kImageCols + kImageCols / 2);
+  EXPECT_EQ(imageCell(o, 0.0, {-1.0, 0.0, 0.0}, vis), -1);  // behind the camera
+}
+
+TEST(ImageCoverage, ANarrowTexturedStripScoresBlindAFullViewDoesNot) {
+  const VisibilityConfig vis;
+  InformationConfig info;
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  const double half_width = 2.0 * std::tan(0.5 * vis.hfov_rad);  // the wall's visible half width at 2 m
+  // Dense landmarks on a strip one eighth of the image wide at its left edge, sparser ones over all of it.
+  const std::vector<WeightedPoint> strip = wall(half_width * 0.76, half_width * 0.99, 0.02);
+  const std::vector<WeightedPoint> full = wall(-0.99 * half_width, 0.99 * half_width, 0.15);
+  ViewSupport a, b;
+  poseInformation(o, 0.0, strip, vis, info, &a);
+  poseInformation(o, 0.0, full, vis, info, &b);
+  EXPECT_GT(a.landmarks, b.landmarks);                 // more map landmarks in the strip ...
+  EXPECT_NEAR(a.coverage(), 1.0 / kImageCols, 1e-12);  // ... on one column of cells
+  EXPECT_GT(b.coverage(), 0.95);
+  const double blind = 6.0 * std::log(info.epsilon);
+  EXPECT_GT(poseScore(o, 0.0, strip, vis, info), blind);  // off by default: the paper's model
+  info.min_image_coverage = 0.25;
+  EXPECT_DOUBLE_EQ(poseScore(o, 0.0, strip, vis, info), blind);
+  EXPECT_GT(poseScore(o, 0.0, full, vis, info), blind);
+  info.min_landmarks = b.landmarks + 1.0;
+  EXPECT_DOUBLE_EQ(poseScore(o, 0.0, full, vis, info), blind);
+}
+
+TEST(Incidence, GrazingViewsDoNotCountWhereTheNormalIsKnown) {
+  InformationConfig info;
+  info.max_incidence_rad = M_PI / 3.0;
+  const WeightedPoint facing{{2.0, 0.0, 0.0}, 1.0, {-1.0, 0.0, 0.0}};
+  EXPECT_TRUE(withinIncidence(Eigen::Vector3d::Zero(), facing, info));
+  EXPECT_FALSE(withinIncidence({0.0, 4.0, 0.0}, facing, info));  // 63 deg off the normal
+  EXPECT_FALSE(withinIncidence({3.0, 0.0, 0.0}, facing, info));  // behind the surface
+  const WeightedPoint unknown{{2.0, 0.0, 0.0}, 1.0, Eigen::Vector3d::Zero()};
+  EXPECT_TRUE(withinIncidence({0.0, 4.0, 0.0}, unknown, info));
+}
+
+TEST(InformationConfig, ValidationNamesTheKey) {
+  InformationConfig info;
+  info.min_image_coverage = 1.5;
+  try {
+    info.validate();
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("min_image_coverage"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace tgnav::planner
