@@ -37,24 +37,21 @@ std::vector<bool> startTurnAllowed(const Eigen::Vector3d& start, const std::vect
   const std::vector<WeightedPoint> points = aggregateByVoxel(voxels, voxels.visibleFrom(start, visibility));
   std::vector<double> view(yaw_of.size());
   for (int k = 0; k < yaws; ++k) {
-    ViewSupport support;
-    const Matrix6d info =
-        poseInformation(start, yaw_of[static_cast<std::size_t>(k)], points, visibility, information, &support);
-    view[static_cast<std::size_t>(k)] = scoreInformation(info, support, information);
+    view[static_cast<std::size_t>(k)] =
+        poseScore(start, yaw_of[static_cast<std::size_t>(k)], points, visibility, information);
   }
-  const double need = floor;
   const double kNoView = std::numeric_limits<double>::infinity();
   std::vector<bool> ok(yaw_of.size(), false);
   ok[0] = true;
   double left = kNoView;
   for (int k = 1; 2 * k <= yaws; ++k) {
     left = std::min(left, view[static_cast<std::size_t>(k)]);
-    ok[static_cast<std::size_t>(k)] = left >= need;
+    ok[static_cast<std::size_t>(k)] = left >= floor;
   }
   double right = kNoView;
   for (int k = yaws - 1; 2 * k >= yaws; --k) {
     right = std::min(right, view[static_cast<std::size_t>(k)]);
-    const bool fine = right >= need;
+    const bool fine = right >= floor;
     ok[static_cast<std::size_t>(k)] = 2 * k == yaws ? ok[static_cast<std::size_t>(k)] && fine : fine;
   }
   return ok;
