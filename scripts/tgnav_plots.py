@@ -3,16 +3,17 @@
 
 Usage: tgnav_plots.py KIND DIR [--format png|pdf|svg] [--out OUTDIR]
 
-KIND is trial, plan, map or report; DIR is the run folder the data files are read from;
+KIND is trial, plan, map, report or eval; DIR is the run folder the data files are read from;
 figures go to OUTDIR (default DIR) as <name>.<format> (default png), each written under a
 temporary name in that folder and renamed into place. Exit status: 0 on success, printing
 nothing; 1 on any other failure (bad or missing data, an unwritable OUTDIR; nothing
 half-written is left behind), printing one line "tgnav_plots.py: error: <file>: <what>";
 2 on bad usage; 3 when matplotlib or numpy cannot be
 imported, printing one line "tgnav_plots.py: figures skipped: ..." (install python3-matplotlib).
-As a module: plot_trial, plot_plan, plot_map and plot_report(dir, out=None, fmt="png") write
-the figures and return their paths; trial_figures, plan_figures, map_figures and
-report_figures(dir) return them as {name: matplotlib Figure} without writing anything.
+As a module: plot_trial, plot_plan, plot_map, plot_report and plot_eval(dir, out=None, fmt="png")
+write the figures and return their paths; trial_figures, plan_figures, map_figures,
+report_figures and eval_figures(dir) return them as {name: matplotlib Figure} without writing
+anything.
 
 Map layer (optional in trial and plan folders, required in map folders):
   map.png   top-down RGB raster of the map; row 0 is the largest y, column 0 the smallest x
@@ -62,6 +63,16 @@ map  (a `tgnav map` folder) -> topdown
   summary.json        optional; `landmarks`, `frames`, `survey_positions`, `resolution_m`
                       make the second title line
   topdown: the raster in metres with start, goal and the map.json legend.
+
+eval  (a `tgnav eval --out` folder) -> eval
+  eval.json        required; `ref`, `est` (file paths), `align`, `pairs`, `alignment.scale`,
+                   `ate.rmse_m` and `rpe` ({"delta", "unit", "pairs", "trans_rmse_m"}) make the titles
+  eval_pairs.csv   required; one row per associated pair: t, ref_x, ref_y, ref_z (the reference),
+                   est_x, est_y, est_z (the aligned estimate), error_m, distance_m (along the
+                   reference)
+  eval: top-down, the reference and the aligned estimate coloured by its error (colour bar from
+  the least error to the largest);
+  beside it the error against the distance along the reference with the RMSE as a line.
 
 report  (a `tgnav report` folder) -> fig3_<scene>, fig4_<scene>, tracking_<scene> per scene,
         plan_time, calibration
@@ -1303,6 +1314,68 @@ def report_figures(folder):
 
 
 # ---------------------------------------------------------------------------------------------
+# eval
+
+
+EVAL_COLUMNS = ("t", "ref_x", "ref_y", "ref_z", "est_x", "est_y", "est_z", "error_m", "distance_m")
+REFERENCE = "#202020"
+ERROR_CMAP = "plasma"
+
+
+def eval_title(summary):
+    name = os.path.basename
+    scale = f", scale {summary['alignment']['scale'].number():.4g}" if summary["align"].text() == "sim3" else ""
+    return (f"{name(summary['est'].text())} against {name(summary['ref'].text())}: ATE ({summary['align'].text()}"
+            f"{scale}) rmse {summary['ate']['rmse_m'].number():.3g} m over {summary['pairs'].integer()} pairs")
+
+
+def rpe_note(rpe):
+    if rpe["pairs"].integer() == 0:
+        return f"RPE ({rpe['delta'].number():g} {rpe['unit'].text()}): no pairs"
+    return (f"RPE ({rpe['delta'].number():g} {rpe['unit'].text()}): rmse {rpe['trans_rmse_m'].number():.3g} m "
+            f"over {rpe['pairs'].integer()} pairs")
+
+
+@styled
+def eval_figure(summary, pairs):
+    fig = new_figure(figsize=(11.0, 4.6))
+    top, along = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.1, 1.0]})
+    ref = np.column_stack([pairs["ref_x"], pairs["ref_y"]])
+    est = np.column_stack([pairs["est_x"], pairs["est_y"]])
+    error = pairs["error_m"]
+    draw_path(top, ref, REFERENCE, 1.6, "reference", zorder=2)
+    draw_path(top, est, "#b0b0b0", 0.8, None, zorder=3)
+    low, high = float(error.min()), float(error.max())  # evo's colour scale: from the least to the largest
+    norm = colors.Normalize(low, high) if high > low else colors.Normalize(low - 0.5, high + 0.5)
+    top.scatter(est[:, 0], est[:, 1], c=error, cmap=ERROR_CMAP, norm=norm, s=10, zorder=4, label="estimate (aligned)")
+    bar = fig.colorbar(ScalarMappable(norm, colormaps[ERROR_CMAP]), ax=top, shrink=0.8)
+    bar.set_label("position error [m]")
+    set_topdown_limits(top, None, [ref, est], margin=0.2)
+    fig.set_size_inches(11.0, 4.6)  # set_topdown_limits sized it for a top-down panel alone
+    top.legend(loc="best")
+    rmse = summary["ate"]["rmse_m"].number()
+    along.plot(pairs["distance_m"], error, color="C0", lw=1.2, label="position error")
+    along.axhline(rmse, color="C3", lw=1.0, dashes=(4, 2), label=f"RMSE {rmse:.3g} m")
+    along.set_xlabel("distance along the reference [m]")
+    along.set_ylabel("position error [m]")
+    along.set_ylim(0.0, 1.35 * high if high > 0 else 1.0)  # room for the legend above the curve
+    along.grid(True, color="#e0e0e0")
+    along.set_axisbelow(True)
+    along.legend(loc="upper right", title=rpe_note(summary["rpe"]))
+    fig.suptitle(eval_title(summary))
+    return fig
+
+
+def eval_figures(folder):
+    """{"eval": Figure} of a `tgnav eval --out` folder."""
+    summary = read_json(os.path.join(folder, "eval.json"))
+    pairs = read_csv_columns(os.path.join(folder, "eval_pairs.csv"), EVAL_COLUMNS)
+    if not len(pairs["t"]):
+        raise DataError(os.path.join(folder, "eval_pairs.csv"), "no pairs")
+    return {"eval": eval_figure(summary, pairs)}
+
+
+# ---------------------------------------------------------------------------------------------
 # Writing figures, and the command line
 
 
@@ -1351,7 +1424,12 @@ def plot_report(folder, out=None, fmt="png"):
     return save_figures(report_figures(folder), out or folder, fmt)
 
 
-PLOTTERS = {"trial": plot_trial, "plan": plot_plan, "map": plot_map, "report": plot_report}
+def plot_eval(folder, out=None, fmt="png"):
+    """eval.<fmt> of a `tgnav eval --out` folder into `out` (default the folder)."""
+    return save_figures(eval_figures(folder), out or folder, fmt)
+
+
+PLOTTERS = {"trial": plot_trial, "plan": plot_plan, "map": plot_map, "report": plot_report, "eval": plot_eval}
 
 
 def one_line(text):

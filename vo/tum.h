@@ -24,8 +24,10 @@ struct StampedPose {
 std::string toTum(const std::vector<StampedPose>& poses);
 // Reads toTum's format (any run of spaces or tabs between numbers; blank lines and '#' lines
 // skipped). Throws std::invalid_argument naming the (1-based) line for a line that is not 8 finite
-// numbers, or whose quaternion's norm is not within 1e-6 of 1; a quaternion within that is
-// normalised. Timestamps are not checked for order here (associate() does).
-std::vector<StampedPose> parseTum(const std::string& text);
+// numbers ("line 3: expected 8 numbers (timestamp tx ty tz qx qy qz qw), got 12": a KITTI file,
+// say), or whose quaternion's norm is not within 1e-3 of 1 (vo::text::kUnitTolerance); a
+// quaternion within that is normalised. Timestamps are not checked for order here (associate()
+// and parseTrajectory() do). `lines`, when given, receives the line of each pose.
+std::vector<StampedPose> parseTum(const std::string& text, std::vector<int>* lines = nullptr);
 
 }  // namespace tgnav::vo

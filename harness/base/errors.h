@@ -20,4 +20,13 @@ inline std::string oneLine(std::string text) {
   return text;
 }
 
+// A library's "line N: what" about a file as "FILE:N: what"; any other message as "FILE: what".
+inline std::string inFile(const std::string& file, const std::string& message) {
+  if (message.rfind("line ", 0) == 0) {
+    const auto colon = message.find(':');
+    if (colon != std::string::npos) return file + ":" + message.substr(5, colon - 5) + message.substr(colon);
+  }
+  return file + ": " + message;
+}
+
 }  // namespace tgnav

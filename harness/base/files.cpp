@@ -2,12 +2,16 @@
 
 #include <fstream>
 #include <iterator>
+#include <system_error>
 
 #include "harness/base/errors.h"
 
 namespace tgnav::harness {
 
 std::string readTextFile(const std::filesystem::path& file) {
+  std::error_code ec;
+  // A folder opens as a stream whose reading throws; say what it is instead.
+  if (std::filesystem::is_directory(file, ec)) throw InputError(file.string() + ": cannot read: it is a directory");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot read");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

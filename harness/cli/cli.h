@@ -13,6 +13,7 @@ namespace tgnav::cli {
 using harness::parseNumbers;
 
 void addDefaultsCommand(CLI::App& app);
+void addEvalCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addSceneCommand(CLI::App& app);

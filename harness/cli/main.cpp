@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   tgnav::cli::addSweepCommand(app);
   tgnav::cli::addReportCommand(app);
   tgnav::cli::addVoCommand(app);
+  tgnav::cli::addEvalCommand(app);
   tgnav::cli::addSceneCommand(app);
   tgnav::cli::addDefaultsCommand(app);
   try {

@@ -20,7 +20,7 @@ struct FigureOutcome {
 
 // Runs `$TGNAV_PYTHON (default /usr/bin/python3) tgnav_plots.py KIND DIR --format F [--out OUT]`
 // with the script from $TGNAV_SCRIPTS_DIR (default: the source tree's scripts/).
-// KIND: trial | plan | map | report (the module's docstring lists their files).
+// KIND: trial | plan | map | report | eval (the module's docstring lists their files).
 FigureOutcome drawFigures(const std::string& kind, const std::filesystem::path& dir, FigureFormat format,
                           const std::filesystem::path& out = {});
 

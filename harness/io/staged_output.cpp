@@ -48,6 +48,20 @@ void writeImageAtomic(const std::filesystem::path& file, const cv::Mat& image) {
   writeFileAtomic(file, std::string(bytes.begin(), bytes.end()));
 }
 
+std::filesystem::path newOutputDir(const std::filesystem::path& requested, const std::string& command) {
+  std::filesystem::path out = std::filesystem::absolute(requested).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();  // "out/" is "out"
+  if (!out.has_filename() || out.filename() == "..") {
+    throw InputError("--out: '" + requested.string() + "' is not a name for a new directory");
+  }
+  std::error_code ec;
+  if (std::filesystem::exists(out, ec)) {
+    throw InputError("--out: " + requested.string() + " already exists; " + command +
+                     " writes a new directory and never overwrites");
+  }
+  return out;
+}
+
 std::filesystem::path stagingPathFor(const std::filesystem::path& target) {
   return target.parent_path() / ("." + target.filename().string() + ".tmp-" + std::to_string(getpid()));
 }

@@ -16,6 +16,11 @@ void writeFileAtomic(const std::filesystem::path& file, const std::string& conte
 // Encodes by extension (.png: 8-bit or 16-bit).
 void writeImageAtomic(const std::filesystem::path& file, const cv::Mat& image);
 
+// The absolute path of a folder that `command` (e.g. "tgnav vo") is to create: InputError naming
+// --out when `requested` is no name for a new folder ("..", "/") or already exists (such commands
+// never overwrite). Nothing is created: StagedDir does that once the results are complete.
+std::filesystem::path newOutputDir(const std::filesystem::path& requested, const std::string& command);
+
 // The staging folder of `target` for this process: `<parent>/.<name>.tmp-<pid>`.
 std::filesystem::path stagingPathFor(const std::filesystem::path& target);
 // True for the name of a staging folder or of a replaced folder awaiting removal

@@ -90,15 +90,6 @@ std::vector<ListEntry> readList(const fs::path& dir, const std::string& name) {
   return entries;
 }
 
-// "line N: what" from parseTum -> "FILE:N: what".
-std::string locate(const fs::path& file, const std::string& message) {
-  if (message.rfind("line ", 0) == 0) {
-    const auto colon = message.find(':');
-    if (colon != std::string::npos) return file.string() + ":" + message.substr(5, colon - 5) + message.substr(colon);
-  }
-  return file.string() + ": " + message;
-}
-
 // TUM's own groundtruth.txt files write quaternions with 4 decimals (|q| off 1 by up to ~1e-4),
 // which vo::parseTum (tolerance 1e-6) refuses: rows of 8 numbers whose |q| is within this of 1
 // get their quaternion normalised first. Everything else passes unchanged, line for line, so
@@ -137,7 +128,7 @@ std::vector<vo::StampedPose> readGroundtruth(const fs::path& file) {
   try {
     poses = vo::parseTum(normaliseQuaternions(text));
   } catch (const std::invalid_argument& e) {
-    throw InputError(locate(file, e.what()));
+    throw InputError(inFile(file.string(), e.what()));
   }
   // Line numbers of the pose rows, for the order check.
   std::vector<int> rows;

@@ -58,20 +58,6 @@ nlohmann::ordered_json numberOrNull(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
 
-fs::path newOutputDir(const fs::path& requested) {
-  fs::path out = fs::absolute(requested).lexically_normal();
-  if (!out.has_filename()) out = out.parent_path();  // "out/" is "out"
-  if (!out.has_filename() || out.filename() == "..") {
-    throw InputError("--out: '" + requested.string() + "' is not a name for a new directory");
-  }
-  std::error_code ec;
-  if (fs::exists(out, ec)) {
-    throw InputError("--out: " + requested.string() +
-                     " already exists; tgnav vo writes a new directory and never overwrites");
-  }
-  return out;
-}
-
 struct Camera {
   vo::CameraIntrinsics intrinsics;
   std::string source;  // where it came from
@@ -224,7 +210,7 @@ nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const 
 }  // namespace
 
 VoRunResult runVo(const VoJob& job) {
-  const fs::path out = newOutputDir(job.out);
+  const fs::path out = newOutputDir(job.out, "tgnav vo");
   vo::OdometryConfig config;
   if (!job.config.empty()) config = loadOdometryConfig(job.config);
   if (job.reinitialise) config.reinitialise_after_lost = true;

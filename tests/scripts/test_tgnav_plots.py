@@ -35,6 +35,7 @@ FIGURES = {
     "plan": ["plan"],
     "map": ["topdown"],
     "report": ["fig3_synthetic", "fig4_synthetic", "tracking_synthetic", "plan_time"],
+    "eval": ["eval"],
 }
 EXTENT = [-4.0, 4.0, -3.0, 3.0]
 EST_OFFSET_M = 0.1  # the VO estimate is the true path shifted in x: error 0.1 everywhere
@@ -172,6 +173,23 @@ def write_report(folder, trials):
     return folder
 
 
+def write_eval(folder):
+    """A `tgnav eval` folder: the reference a circle of radius 2 m, the aligned estimate off it
+    radially by an error growing from 0 to 0.2 m."""
+    os.makedirs(folder, exist_ok=True)
+    angle = np.linspace(0.0, 2.0 * math.pi, 41)
+    error = np.linspace(0.0, 0.2, 41)
+    rows = [f"{0.1 * k:.1f},{2 * math.cos(a):.6f},{2 * math.sin(a):.6f},1,{(2 + e) * math.cos(a):.6f},"
+            f"{(2 + e) * math.sin(a):.6f},1,{e:.6f},{2 * a:.6f}\n" for k, (a, e) in enumerate(zip(angle, error))]
+    write(folder, "eval_pairs.csv", "t,ref_x,ref_y,ref_z,est_x,est_y,est_z,error_m,distance_m\n" + "".join(rows))
+    write_json(folder, "eval.json", {
+        "ref": "/data/gt.tum", "est": "/data/est.tum", "format": "tum", "align": "sim3", "pairs": 41,
+        "alignment": {"rotation": [[1, 0, 0], [0, 1, 0], [0, 0, 1]], "translation": [0, 0, 0], "scale": 1.5},
+        "ate": {"rmse_m": float(np.sqrt(np.mean(error ** 2))), "mean_m": 0.1},
+        "rpe": {"delta": 1.0, "unit": "m", "pairs": 30, "trans_rmse_m": 0.01}})
+    return folder
+
+
 # ---------------------------------------------------------------------------------------------
 # Checks
 
@@ -249,6 +267,8 @@ class PlotsTest(unittest.TestCase):
             return write_plan(folder)
         if kind == "map":
             return write_map(folder)
+        if kind == "eval":
+            return write_eval(folder)
         return write_report(folder, [write_trial(self.folder("a"), lost=False), write_trial(self.folder("b"))])
 
     def assert_figures(self, folder, names, fmt, inputs):
@@ -326,6 +346,8 @@ class PlotsTest(unittest.TestCase):
             ("map", "map.json", lambda f: os.remove(os.path.join(f, "map.json"))),
             ("report", "report.json", lambda f: write(f, "report.json", '{"scenes": [')),
             ("report", os.path.join(trial_b, "gt.tum"), lambda f: write(trial_b, "gt.tum", "0 1 2\n")),
+            ("eval", "eval_pairs.csv", lambda f: self.corrupt_cell(os.path.join(f, "eval_pairs.csv"), 2, 7, "x")),
+            ("eval", "eval.json", lambda f: write_json(f, "eval.json", {"align": "se3"})),
         ]
         for k, (kind, file, damage) in enumerate(cases):
             with self.subTest(kind=kind, file=file):
@@ -456,6 +478,24 @@ class PlotsTest(unittest.TestCase):
         mean = line(fig4, "Proposed (1/2)")
         values = np.asarray(mean.get_ydata(), dtype=float)
         np.testing.assert_allclose(values[np.isfinite(values)], EST_OFFSET_M, atol=1e-5)
+
+    def test_eval_colours_the_estimate_by_its_error(self):
+        fig = tgnav_plots.eval_figures(write_eval(self.folder("eval")))["eval"]
+        top, along = fig.axes[:2]
+        self.assertIn("est.tum against gt.tum: ATE (sim3, scale 1.5) rmse", fig._suptitle.get_text())
+        # The scatter holds the aligned estimate, coloured by error_m on a scale from 0 to the largest.
+        points = top.collections[0]
+        np.testing.assert_allclose(points.get_offsets()[-1], [2.2, 0.0], atol=1e-6)
+        np.testing.assert_allclose(points.get_array()[[0, 20, 40]], [0.0, 0.1, 0.2], atol=1e-6)
+        self.assertEqual((points.norm.vmin, points.norm.vmax), (0.0, 0.2))
+        self.assertEqual(line(top, "reference").get_color(), tgnav_plots.REFERENCE)
+        # Beside it: the error along the reference, and the RMSE as a horizontal line.
+        curve = line(along, "position error")
+        np.testing.assert_allclose(curve.get_xdata()[-1], 4 * math.pi, atol=1e-5)
+        np.testing.assert_allclose(curve.get_ydata()[-1], 0.2, atol=1e-6)
+        rmse = math.sqrt(float(np.mean(np.linspace(0.0, 0.2, 41) ** 2)))
+        self.assertEqual(list(line(along, f"RMSE {rmse:.3g} m").get_ydata()), [rmse, rmse])
+        self.assertIn("RPE (1 m): rmse 0.01 m over 30 pairs", along.get_legend().get_title().get_text())
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1,5 +1,7 @@
 // Trajectory metrics: Umeyama alignment (exact, noisy, degenerate), ATE aligned and anchored, RPE
-// per distance (scale drift, yaw drift), association by timestamp, goal error and path length.
+// per distance (scale drift, yaw drift), association by timestamp, goal error and path length;
+// evo's definitions for any trajectory pair: every alignment (se3, sim3, posyaw, origin, none) on
+// hand-made offsets, rotations and scales, evo's statistics, RPE per frame and per metre.
 #include "vo/metrics.h"
 
 #include <gtest/gtest.h>
@@ -395,6 +397,225 @@ TEST(GoalAndDistance, HandExamples) {
   EXPECT_EQ(distanceTravelled({}), 0.0);
   EXPECT_EQ(distanceTravelled({pairs.front()}), 0.0);
   EXPECT_EQ(goalError({pairs.front()}), 0.0);
+}
+
+// --- evo's definitions: alignments, statistics, RPE in frames (tgnav eval) ------------------------
+
+// A wavy path's poses (wavyPath) with each estimate mapped by `f` (position and rotation).
+std::vector<PosePair> mappedPairs(int n, const std::function<Eigen::Isometry3d(const Eigen::Isometry3d&)>& f) {
+  const auto gt = wavyPath(n);
+  std::vector<Eigen::Isometry3d> est;
+  for (const auto& X : gt) est.push_back(f(X));
+  return pairsOf(est, gt);
+}
+
+Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+Eigen::Matrix3d rotX(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitX()).toRotationMatrix(); }
+
+TEST(Alignment, NamesRoundTripAndUnknownIsRejected) {
+  for (const char* name : {"se3", "sim3", "posyaw", "origin", "none"})
+    EXPECT_STREQ(toString(parseAlignment(name)), name);
+  const std::string msg = errorOf([] { parseAlignment("SE3"); });
+  EXPECT_NE(msg.find("'SE3' is not an alignment; expected se3, sim3, posyaw, origin or none"), std::string::npos)
+      << msg;
+}
+
+TEST(ErrorStatistics, HandComputedAsNumpy) {
+  const ErrorStatistics s = errorStatistics({4.0, 1.0, 3.0, 2.0});
+  EXPECT_EQ(s.n, 4);
+  EXPECT_DOUBLE_EQ(s.sse, 30.0);
+  EXPECT_DOUBLE_EQ(s.rmse, std::sqrt(7.5));
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_DOUBLE_EQ(s.median, 2.5);           // even n: mean of the middle two
+  EXPECT_DOUBLE_EQ(s.std, std::sqrt(1.25));  // population (ddof = 0)
+  EXPECT_EQ(s.min, 1.0);
+  EXPECT_EQ(s.max, 4.0);
+  EXPECT_EQ(errorStatistics({3.0, 1.0, 2.0}).median, 2.0);
+  const ErrorStatistics none = errorStatistics({});
+  EXPECT_EQ(none.n, 0);
+  EXPECT_EQ(none.sse, 0.0);
+  for (const double v : {none.rmse, none.mean, none.median, none.std, none.min, none.max}) EXPECT_TRUE(std::isnan(v));
+}
+
+TEST(Ape, PureTranslationOffset) {
+  // The estimate is the ground truth moved by d = (0.3, -0.4, 1.2), |d| = 1.3: every rigid or
+  // similarity alignment removes it; none leaves |d| at every pair.
+  const Eigen::Vector3d d(0.3, -0.4, 1.2);
+  const auto pairs = mappedPairs(60, [&](const Eigen::Isometry3d& X) {
+    Eigen::Isometry3d Y = X;
+    Y.translation() += d;
+    return Y;
+  });
+  for (const Alignment a : {Alignment::kSe3, Alignment::kSim3, Alignment::kPosYaw, Alignment::kOrigin}) {
+    const ApeResult r = absolutePoseError(pairs, a);
+    EXPECT_EQ(r.stats_m.n, 60);
+    EXPECT_LT(r.stats_m.max, 1e-9) << toString(a);
+    EXPECT_LT((r.alignment.t + d).norm(), 1e-9) << toString(a);
+    EXPECT_NEAR(r.alignment.scale, 1.0, 1e-12) << toString(a);
+  }
+  const ApeResult none = absolutePoseError(pairs, Alignment::kNone);
+  ASSERT_EQ(none.errors_m.size(), 60u);
+  for (const double e : none.errors_m) EXPECT_NEAR(e, 1.3, 1e-12);
+  for (const double v :
+       {none.stats_m.rmse, none.stats_m.mean, none.stats_m.median, none.stats_m.min, none.stats_m.max}) {
+    EXPECT_NEAR(v, 1.3, 1e-12);
+  }
+  EXPECT_NEAR(none.stats_m.std, 0.0, 1e-12);
+  EXPECT_NEAR(none.stats_m.sse, 60 * 1.69, 1e-9);
+  EXPECT_TRUE(none.alignment.R.isIdentity(0.0));
+}
+
+TEST(Ape, RotationAboutAnyAxis) {
+  // A rigid motion with roll, pitch and yaw: se3, sim3 and origin undo it; posyaw cannot (it only
+  // turns about z) and none does not try.
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(1.0, Eigen::Vector3d(1, 1, 0.2).normalized()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(2, -1, 3);
+  const auto pairs = mappedPairs(80, [&](const Eigen::Isometry3d& X) { return T * X; });
+  for (const Alignment a : {Alignment::kSe3, Alignment::kSim3, Alignment::kOrigin}) {
+    const ApeResult r = absolutePoseError(pairs, a);
+    EXPECT_LT(r.stats_m.rmse, 1e-9) << toString(a);
+    EXPECT_LT((r.alignment.R - T.linear().transpose()).norm(), 1e-9) << toString(a);
+    // The aligned estimate's poses, rotations included, are the ground truth's.
+    for (const PosePair& p : alignedPairs(pairs, r.alignment)) expectNear(p.X_WC_est, p.X_WC_gt, 1e-9, 1e-9);
+  }
+  EXPECT_GT(absolutePoseError(pairs, Alignment::kPosYaw).stats_m.rmse, 0.1);
+  EXPECT_GT(absolutePoseError(pairs, Alignment::kNone).stats_m.rmse, 1.0);
+}
+
+TEST(Ape, ScaleIsRecoveredBySim3Only) {
+  // The estimate is the ground truth at half scale, turned and moved (a monocular VO's output):
+  // sim3 finds the scale 2 back and leaves no error; se3 cannot scale.
+  const Eigen::Matrix3d R0 = rotZ(0.8) * rotX(0.3);
+  const Eigen::Vector3d t0(5, -2, 1);
+  const auto pairs = mappedPairs(80, [&](const Eigen::Isometry3d& X) {
+    Eigen::Isometry3d Y = Eigen::Isometry3d::Identity();
+    Y.linear() = R0 * X.linear();
+    Y.translation() = R0 * (0.5 * X.translation()) + t0;
+    return Y;
+  });
+  const ApeResult sim3 = absolutePoseError(pairs, Alignment::kSim3);
+  EXPECT_NEAR(sim3.alignment.scale, 2.0, 1e-9);
+  EXPECT_LT((sim3.alignment.R - R0.transpose()).norm(), 1e-9);
+  EXPECT_LT((sim3.alignment.t + 2.0 * R0.transpose() * t0).norm(), 1e-9);
+  EXPECT_LT(sim3.stats_m.max, 1e-9);
+  const ApeResult se3 = absolutePoseError(pairs, Alignment::kSe3);
+  EXPECT_EQ(se3.alignment.scale, 1.0);
+  EXPECT_GT(se3.stats_m.rmse, 0.3);
+  // Relative motions of the scaled estimate are half as long: RPE sees the scale unless the
+  // sim3-aligned pairs are used.
+  const RpeStatistics raw = rpeStatistics(pairs, 1, RpeUnit::kFrames);
+  const RpeStatistics aligned = rpeStatistics(alignedPairs(pairs, sim3.alignment), 1, RpeUnit::kFrames);
+  EXPECT_GT(raw.trans_m.rmse, 0.05);
+  EXPECT_LT(aligned.trans_m.rmse, 1e-9);
+  EXPECT_LT(aligned.rot_rad.rmse, 1e-7);
+}
+
+TEST(Ape, PosYawRecoversYawAndTranslationButNotRoll) {
+  const Eigen::Vector3d t0(1.5, -0.5, 0.25);
+  auto moved = [&](const Eigen::Matrix3d& R) {
+    return mappedPairs(80, [&](const Eigen::Isometry3d& X) {
+      Eigen::Isometry3d Y = Eigen::Isometry3d::Identity();
+      Y.linear() = R * X.linear();
+      Y.translation() = R * X.translation() + t0;
+      return Y;
+    });
+  };
+  // Yaw 2 rad (beyond +-pi/2, so atan2's quadrant matters) and a translation.
+  const ApeResult yaw = absolutePoseError(moved(rotZ(2.0)), Alignment::kPosYaw);
+  EXPECT_LT(yaw.stats_m.max, 1e-9);
+  EXPECT_LT((yaw.alignment.R - rotZ(-2.0)).norm(), 1e-12);
+  EXPECT_LT((yaw.alignment.t + rotZ(-2.0) * t0).norm(), 1e-9);
+  // A roll of 0.2 rad: posyaw leaves an error that se3 removes.
+  const auto rolled = moved(rotX(0.2));
+  EXPECT_GT(absolutePoseError(rolled, Alignment::kPosYaw).stats_m.rmse, 0.05);
+  EXPECT_LT(absolutePoseError(rolled, Alignment::kSe3).stats_m.rmse, 1e-9);
+  const Similarity3 S = posYawAlignment(std::vector<Eigen::Vector3d>{}, {});
+  EXPECT_TRUE(S.R.isIdentity(0.0));
+  EXPECT_THROW(posYawAlignment({{0, 0, 0}}, {}), std::invalid_argument);
+  EXPECT_THROW(posYawAlignment({{0, 0, NAN}}, {{0, 0, 0}}), std::invalid_argument);
+}
+
+TEST(Ape, KeepsTheTrialCodesNumbers) {
+  // absoluteTrajectoryError is absolutePoseError with se3 (align) or origin (anchored).
+  const auto gt = wavyPath(50);
+  auto est = gt;
+  std::mt19937 rng(6);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (auto& X : est) X.translation() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+  const auto pairs = pairsOf(est, gt);
+  for (const bool align : {true, false}) {
+    const AteResult old = absoluteTrajectoryError(pairs, align);
+    const ApeResult ape = absolutePoseError(pairs, align ? Alignment::kSe3 : Alignment::kOrigin);
+    EXPECT_EQ(old.rmse_m, ape.stats_m.rmse);
+    EXPECT_EQ(old.mean_m, ape.stats_m.mean);
+    EXPECT_EQ(old.max_m, ape.stats_m.max);
+    EXPECT_TRUE(old.alignment.linear() == ape.alignment.R);
+  }
+  const RpeResult old = relativePoseError(pairs, 0.5);
+  const RpeStatistics rpe = rpeStatistics(pairs, 0.5, RpeUnit::kMetres);
+  EXPECT_EQ(old.pairs, rpe.trans_m.n);
+  EXPECT_EQ(old.trans_rmse_m, rpe.trans_m.rmse);
+  EXPECT_EQ(old.rot_rmse_rad, rpe.rot_rad.rmse);
+}
+
+TEST(Ape, MissingTimestampsAndDifferentRates) {
+  // Ground truth at 100 Hz over 0..4 s with nothing from 1.5 to 2.5 s; the estimate at 20 Hz,
+  // 3 ms late, 0.5 m off in x. The estimates in the gap have no partner.
+  std::vector<StampedPose> gt, est;
+  for (int k = 0; k <= 400; ++k) {
+    if (k > 150 && k < 250) continue;
+    const double t = 0.01 * k;
+    gt.push_back(StampedPose{t, pose({t, std::sin(t), 0.1 * t * t}, 0.3 * t)});
+  }
+  for (int k = 0; k <= 80; ++k) {
+    const double t = 0.05 * k;
+    est.push_back(StampedPose{t + 0.003, pose({t + 0.5, std::sin(t), 0.1 * t * t}, 0.3 * t)});
+  }
+  const auto pairs = associate(est, gt, 0.02);
+  // 81 estimates, of which those at 1.55 .. 2.45 s (19) fall in the gap.
+  ASSERT_EQ(pairs.size(), 81u - 19u);
+  for (const PosePair& p : pairs) EXPECT_NEAR(p.X_WC_gt.translation().x(), p.t_s - 0.003, 1e-12);
+  const ApeResult none = absolutePoseError(pairs, Alignment::kNone);
+  EXPECT_NEAR(none.stats_m.min, 0.5, 1e-12);
+  EXPECT_NEAR(none.stats_m.max, 0.5, 1e-12);
+  EXPECT_LT(absolutePoseError(pairs, Alignment::kSe3).stats_m.max, 1e-9);
+  // A tighter tolerance than the 3 ms delay pairs nothing.
+  EXPECT_TRUE(associate(est, gt, 0.002).empty());
+}
+
+TEST(RpeStatistics, FramesAndMetresOnAStraightLine) {
+  // Ground truth steps 0.1 m along x; the estimate steps 0.11 m: 0.01 m error per step.
+  std::vector<PosePair> pairs;
+  for (int i = 0; i <= 50; ++i) pairs.push_back(PosePair{0.1 * i, pose({0.11 * i, 0, 1}), pose({0.1 * i, 0, 1})});
+  const RpeStatistics one = rpeStatistics(pairs, 1, RpeUnit::kFrames);
+  EXPECT_EQ(one.trans_m.n, 50);
+  EXPECT_NEAR(one.trans_m.rmse, 0.01, 1e-12);
+  EXPECT_NEAR(one.trans_m.max, 0.01, 1e-12);
+  EXPECT_NEAR(one.rot_rad.max, 0.0, 1e-12);
+  const RpeStatistics five = rpeStatistics(pairs, 5, RpeUnit::kFrames);
+  EXPECT_EQ(five.trans_m.n, 46);  // (i, i + 5) for i = 0 .. 45
+  EXPECT_NEAR(five.trans_m.rmse, 0.05, 1e-12);
+  EXPECT_NEAR(five.trans_m.std, 0.0, 1e-12);
+  // 5 frames are 0.5 m of ground truth (just under, so rounding cannot push j one further).
+  const RpeStatistics half = rpeStatistics(pairs, 0.4999, RpeUnit::kMetres);
+  EXPECT_EQ(half.trans_m.n, 46);
+  EXPECT_NEAR(half.trans_m.rmse, 0.05, 1e-12);
+  EXPECT_EQ(half.unit, RpeUnit::kMetres);
+  EXPECT_EQ(half.delta, 0.4999);
+  // Longer than the path: no pairs.
+  EXPECT_EQ(rpeStatistics(pairs, 51, RpeUnit::kFrames).trans_m.n, 0);
+  EXPECT_TRUE(std::isnan(rpeStatistics(pairs, 6.0, RpeUnit::kMetres).trans_m.rmse));
+  for (const double bad : {0.0, 1.5, -2.0, double(NAN), double(INFINITY)}) {
+    const std::string msg = errorOf([&] { rpeStatistics(pairs, bad, RpeUnit::kFrames); });
+    EXPECT_NE(msg.find("whole number"), std::string::npos) << bad << ": " << msg;
+  }
+  EXPECT_THROW(rpeStatistics(pairs, 0.0, RpeUnit::kMetres), std::invalid_argument);
+}
+
+TEST(PathLength, SumOfSteps) {
+  EXPECT_EQ(pathLength({}), 0.0);
+  EXPECT_NEAR(pathLength(stamped({0.0, 1.0, 3.5})), 3.5, 1e-15);
 }
 
 }  // namespace
