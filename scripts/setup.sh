@@ -12,6 +12,7 @@ packages=(
   libeigen3-dev libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev liboctomap-dev
   libompl-dev libtbb-dev              # RRT* baseline; homology classes evaluated in parallel
   liblbfgspp-dev                      # trajectory optimisation (L-BFGS)
+  libceres-dev                        # the VO's local bundle adjustment
   libopencv-contrib-dev               # cv::rgbd::RgbdOdometry, the peer in the VO benchmark
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL's CMake links these
   libgtest-dev libgmock-dev libbenchmark-dev

@@ -1,6 +1,7 @@
 #include "vo/features.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -71,6 +72,19 @@ Features FeatureDetector::detect(const cv::Mat& gray) const {
   out.keypoints.reserve(kept.size());
   for (int i : kept) out.keypoints.push_back(candidates[i]);
   orb_->compute(gray, out.keypoints, out.descriptors);
+  // ORB reports a keypoint found on pyramid level o at (level pixel) x scale^o, but the level
+  // image is the full image resized to round(size / scale^o) with pixel centres aligned: the
+  // pixel it was found at is at (x_o + 0.5) size / size_o - 0.5 in the full image. Without this
+  // the coarse levels' keypoints are off by up to ~1.5 px (a magnification that biases pose and
+  // depth estimates).
+  for (cv::KeyPoint& kp : out.keypoints) {
+    if (kp.octave <= 0) continue;
+    const double sf = std::pow(config_.scale_factor, kp.octave);
+    const double w_o = std::round(gray.cols / sf);
+    const double h_o = std::round(gray.rows / sf);
+    kp.pt.x = static_cast<float>((kp.pt.x / sf + 0.5) * gray.cols / w_o - 0.5);
+    kp.pt.y = static_cast<float>((kp.pt.y / sf + 0.5) * gray.rows / h_o - 0.5);
+  }
   return out;
 }
 

@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
+#include <unordered_map>
+#include <utility>
 
 #include "vo/check.h"
 
@@ -97,6 +99,7 @@ void OdometryConfig::validate() const {
   require(keyframe_translation_m > 0.0, "keyframe_translation_m", keyframe_translation_m, "must be > 0");
   require(keyframe_rotation_rad > 0.0, "keyframe_rotation_rad", keyframe_rotation_rad, "must be > 0");
   require(landmark_max_misses >= 1, "landmark_max_misses", landmark_max_misses, "must be >= 1");
+  ba.validate();
 }
 
 const char* toString(TrackingStatus status) {
@@ -196,8 +199,9 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
   const Eigen::Isometry3d X_WC = pose.X_CW.inverse();
   velocity_ = X_WC_.inverse() * X_WC;
   X_WC_ = X_WC;
-  result.X_WC = X_WC;
   result.keyframe = updateLocalMap(frame, matches, pose);
+  if (result.keyframe && config_.ba.enabled) adjustLocalMap(&result);
+  result.X_WC = X_WC_;
   return record(result);
 }
 
@@ -271,6 +275,7 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const Frame& frame) {
   velocity_.setIdentity();
   landmarks_.clear();
   keyframes_.clear();
+  retired_.clear();
   addKeyframe(X_WC_, frame, std::vector<int>(frame.features.keypoints.size(), -1), 0);
   result.X_WC = X_WC_;
   result.status = TrackingStatus::kOk;
@@ -453,9 +458,23 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame
   kf.id = next_keyframe_id_++;
   kf.X_WC = X_WC;
   int created = 0;
+  const double sigma_step = config_.features.scale_factor;
   for (std::size_t i = 0; i < frame.features.keypoints.size(); ++i) {
-    if (!frame.valid[i] || matched_landmark[i] >= 0) continue;  // tracked keypoints already have a landmark
+    const cv::KeyPoint& kp = frame.features.keypoints[i];
+    Observation obs;
+    obs.uv = Eigen::Vector2d(kp.pt.x, kp.pt.y);
+    obs.depth_m = frame.valid[i] ? frame.p_C[i].z() : 0.0;
+    obs.sigma_px = std::pow(sigma_step, std::max(0, kp.octave));
+    if (matched_landmark[i] >= 0) {  // tracked keypoints already have a landmark
+      obs.landmark = landmarks_[static_cast<std::size_t>(matched_landmark[i])].id;
+      kf.observations.push_back(obs);
+      continue;
+    }
+    if (!frame.valid[i]) continue;
     Landmark lm;
+    lm.id = next_landmark_id_++;
+    obs.landmark = lm.id;
+    kf.observations.push_back(obs);
     lm.p_W = X_WC * frame.p_C[i];
     lm.descriptor = descriptorBits(frame.features.descriptors, static_cast<int>(i));
     lm.keyframe = kf.id;
@@ -469,6 +488,10 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame
   // leaving it go too, unless they were matched in this frame (they then belong to the newest).
   while (static_cast<int>(keyframes_.size()) > config_.local_map_keyframes) {
     const int gone = keyframes_.front().id;
+    // It stays, fixed, in bundle adjustment's window for a while: its observations of the
+    // landmarks that outlive it anchor them.
+    retired_.push_back(std::move(keyframes_.front()));
+    while (static_cast<int>(retired_.size()) > config_.ba.fixed_keyframes) retired_.pop_front();
     keyframes_.pop_front();
     for (Landmark& lm : landmarks_) {
       if (lm.keyframe == gone && lm.last_seen == frame_) lm.keyframe = kf.id;
@@ -477,6 +500,89 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame
         std::remove_if(landmarks_.begin(), landmarks_.end(), [&](const Landmark& lm) { return lm.keyframe == gone; }),
         landmarks_.end());
   }
+}
+
+// Local bundle adjustment: the local map's keyframes are free, the last ba.fixed_keyframes that
+// left it are fixed (the gauge; until there are any, the oldest local keyframe is fixed), and
+// every landmark they observe is free. The new keyframe's pose becomes the current estimate.
+void RgbdOdometry::adjustLocalMap(FrameResult* result) {
+  if (retired_.empty() && keyframes_.size() < 2) return;
+  std::vector<Keyframe*> window;
+  for (Keyframe& kf : retired_) window.push_back(&kf);
+  for (Keyframe& kf : keyframes_) window.push_back(&kf);
+  const std::size_t fixed = retired_.empty() ? 1 : retired_.size();
+  std::unordered_map<long, int> index_of;  // landmark id -> index in landmarks_
+  index_of.reserve(landmarks_.size());
+  for (std::size_t l = 0; l < landmarks_.size(); ++l) index_of.emplace(landmarks_[l].id, static_cast<int>(l));
+
+  BaProblem problem;
+  std::vector<int> landmark_of;             // problem landmark -> landmarks_ index
+  std::unordered_map<int, int> in_problem;  // landmarks_ index -> problem landmark
+  std::vector<std::pair<int, int>> source;  // problem observation -> (window keyframe, observation)
+  for (std::size_t k = 0; k < window.size(); ++k) {
+    problem.X_CW.push_back(window[k]->X_WC.inverse());
+    problem.fixed.push_back(k < fixed);
+    const std::vector<Observation>& obs = window[k]->observations;
+    for (std::size_t o = 0; o < obs.size(); ++o) {
+      const auto found = index_of.find(obs[o].landmark);
+      if (found == index_of.end()) continue;  // culled, or gone with its keyframe
+      auto [it, added] = in_problem.emplace(found->second, static_cast<int>(problem.p_W.size()));
+      if (added) {
+        problem.p_W.push_back(landmarks_[static_cast<std::size_t>(found->second)].p_W);
+        landmark_of.push_back(found->second);
+      }
+      BaObservation b;
+      b.keyframe = static_cast<int>(k);
+      b.landmark = it->second;
+      b.uv = obs[o].uv;
+      b.depth_m = obs[o].depth_m;
+      b.sigma_px = obs[o].sigma_px;
+      problem.observations.push_back(b);
+      source.emplace_back(static_cast<int>(k), static_cast<int>(o));
+    }
+  }
+  const BaReport report = bundleAdjust(&problem, camera_, config_.ba);
+  if (!report.solved) return;
+
+  const Eigen::Isometry3d before = keyframes_.back().X_WC;
+  for (std::size_t k = fixed; k < window.size(); ++k) window[k]->X_WC = problem.X_CW[k].inverse();
+  for (std::size_t j = 0; j < landmark_of.size(); ++j) {
+    landmarks_[static_cast<std::size_t>(landmark_of[j])].p_W = problem.p_W[j];
+  }
+  // Outlier observations go; a landmark with no observation left in the window goes too.
+  std::vector<int> inliers_of(problem.p_W.size(), 0);
+  std::vector<std::vector<bool>> drop(window.size());
+  for (std::size_t k = 0; k < window.size(); ++k) drop[k].assign(window[k]->observations.size(), false);
+  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
+    if (report.outlier[i]) {
+      drop[static_cast<std::size_t>(source[i].first)][static_cast<std::size_t>(source[i].second)] = true;
+    } else {
+      ++inliers_of[static_cast<std::size_t>(problem.observations[i].landmark)];
+    }
+  }
+  for (std::size_t k = 0; k < window.size(); ++k) {
+    std::vector<Observation>& obs = window[k]->observations;
+    std::size_t w = 0;
+    for (std::size_t o = 0; o < obs.size(); ++o) {
+      if (!drop[k][o]) obs[w++] = obs[o];
+    }
+    obs.resize(w);
+  }
+  std::vector<bool> remove(landmarks_.size(), false);
+  for (std::size_t j = 0; j < landmark_of.size(); ++j) {
+    if (inliers_of[j] == 0) remove[static_cast<std::size_t>(landmark_of[j])] = true;
+  }
+  std::size_t w = 0;
+  for (std::size_t l = 0; l < landmarks_.size(); ++l) {
+    if (!remove[l]) landmarks_[w++] = std::move(landmarks_[l]);
+  }
+  landmarks_.resize(w);
+
+  X_WC_ = keyframes_.back().X_WC;
+  const Eigen::Isometry3d change = before.inverse() * X_WC_;
+  result->ba_correction_m = change.translation().norm();
+  result->ba_correction_rad = rotationAngle(change.linear());
+  result->ba_outliers = report.outliers;
 }
 
 // Lost: the last good pose stands; with reinitialise_after_lost the next frame with enough
@@ -491,6 +597,7 @@ FrameResult RgbdOdometry::lose(FrameResult result, const std::string& why) {
     X_WC0_ = X_WC_;  // carry on from the last good pose
     landmarks_.clear();
     keyframes_.clear();
+    retired_.clear();
     velocity_.setIdentity();
   }
   return record(result);

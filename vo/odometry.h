@@ -2,7 +2,11 @@
 // RGB-D feature visual odometry: ORB features (grid-spread) with depth, tracked against a local
 // map of the recent keyframes' 3D landmarks by descriptor matching inside a motion-model window,
 // pose by PnP RANSAC refined on the inliers (Levenberg-Marquardt on reprojection error),
-// keyframes by inlier ratio and motion, landmarks culled when they stop being matched.
+// keyframes by inlier ratio and motion, landmarks culled when they stop being matched. When a
+// keyframe is added, a local bundle adjustment (vo/bundle_adjustment.h) refines the local map's
+// keyframes and the landmarks they observe, with the last keyframes that left the local map held
+// fixed as the gauge (their observations anchor the landmarks that outlived them); outlier
+// observations are dropped, and a landmark left without any is removed.
 //
 // Tracking status per frame, with the counts behind it: ok, weak (few inliers), lost (inliers
 // below min_inliers, ORB-SLAM2's 30 by default). The paper counts a run as failed at the first
@@ -12,10 +16,12 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "vo/bundle_adjustment.h"
 #include "vo/camera_intrinsics.h"
 #include "vo/features.h"
 
@@ -43,6 +49,7 @@ struct OdometryConfig {
   double keyframe_rotation_rad = 0.35;  // ... or turned this much
   int landmark_max_misses = 10;         // cull a landmark not matched in this many frames it was expected in
   bool reinitialise_after_lost = false;
+  BundleAdjustmentConfig ba;  // local bundle adjustment over the local map's keyframes
 
   // Names every field once, for the harness's config files (a(key, field), `features` as a
   // mapping; harness/config/yaml_util.h): configs/vo.yaml.
@@ -67,6 +74,7 @@ struct OdometryConfig {
     a("keyframe_rotation_rad", keyframe_rotation_rad);
     a("landmark_max_misses", landmark_max_misses);
     a("reinitialise_after_lost", reinitialise_after_lost);
+    a("ba", ba);
   }
 
   void validate() const;  // std::invalid_argument naming the field and value
@@ -89,6 +97,11 @@ struct FrameResult {
   int inliers = 0;                                         // PnP RANSAC inliers after refinement
   bool keyframe = false;                                   // this frame became a keyframe
   bool reinitialised = false;
+  // For a keyframe after bundle adjustment (NaN otherwise): how far BA moved and turned this
+  // keyframe's pose, and the observations it rejected as outliers in the window.
+  double ba_correction_m = std::numeric_limits<double>::quiet_NaN();
+  double ba_correction_rad = std::numeric_limits<double>::quiet_NaN();
+  int ba_outliers = 0;
   std::string reason;  // for lost frames: why (e.g. "12 inliers < 30")
 };
 
@@ -109,16 +122,24 @@ class RgbdOdometry {
 
  private:
   struct Landmark {
+    long id = 0;  // unique over the run (keyframe observations refer to it)
     Eigen::Vector3d p_W;
     std::array<std::uint64_t, 4> descriptor{};  // the 256-bit ORB descriptor
     int misses = 0;
     int keyframe = 0;    // id of the keyframe it belongs to (created it, or last kept it)
     long last_seen = 0;  // frame number it was created or last matched in
   };
+  struct Observation {
+    long landmark = 0;  // Landmark::id
+    Eigen::Vector2d uv;
+    double depth_m = 0.0;   // 0: none
+    double sigma_px = 1.0;  // the keypoint's scale
+  };
   struct Keyframe {
     int id = 0;
     Eigen::Isometry3d X_WC;
-    int tracked = 0;  // landmarks it tracked or created
+    int tracked = 0;                        // landmarks it tracked or created
+    std::vector<Observation> observations;  // landmarks it tracked or created, where it saw them
   };
   struct Frame;            // features and their 3D points
   struct LocalMapMatches;  // landmarks matched to a frame's keypoints
@@ -142,6 +163,8 @@ class RgbdOdometry {
   bool needsKeyframe(int inliers) const;
   void addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame, const std::vector<int>& matched_landmark,
                    int tracked);
+  // Local bundle adjustment after a keyframe; fills result's ba_* fields.
+  void adjustLocalMap(FrameResult* result);
   void markFailed(double t_s);                    // the first loss
   FrameResult record(const FrameResult& result);  // into history_
 
@@ -156,8 +179,10 @@ class RgbdOdometry {
   Eigen::Isometry3d X_WC_ = Eigen::Isometry3d::Identity();      // last estimate
   Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  // X_{C_prev C} of the last step
   std::vector<Landmark> landmarks_;
-  std::deque<Keyframe> keyframes_;
+  std::deque<Keyframe> keyframes_;  // the local map's
+  std::deque<Keyframe> retired_;    // the last ones that left it (bundle adjustment's gauge)
   int next_keyframe_id_ = 0;
+  long next_landmark_id_ = 0;
   long frame_ = 0;  // frames tracked
   std::vector<FrameResult> history_;
 };

@@ -58,6 +58,7 @@ void ImuConfig::validate() const {
 void TrialConfig::validate() const {
   require(std::isfinite(camera_rate_hz) && camera_rate_hz > 0.0, "camera_rate_hz", camera_rate_hz, "must be > 0");
   require(std::isfinite(goal_radius_m) && goal_radius_m > 0.0, "goal_radius_m", goal_radius_m, "must be > 0");
+  require(std::isfinite(max_drift_ratio) && max_drift_ratio > 0.0, "max_drift_ratio", max_drift_ratio, "must be > 0");
   validateMember(flight, "flight");
   validateMember(imu, "imu");
   validateMember(estimator, "estimator");

@@ -41,6 +41,9 @@ struct TrialConfig {
   StateSource state_source = StateSource::kGroundTruth;
   double camera_rate_hz = 20.0;
   double goal_radius_m = 0.5;
+  // A trial whose VO tracked to the end but whose goal error exceeds this fraction of the
+  // distance flown is `drifted`, not `success` (harness/run/trial_status.h).
+  double max_drift_ratio = 0.01;
   bool pipeline = true;
   FlightConfig flight;
   ImuConfig imu;
@@ -52,6 +55,7 @@ struct TrialConfig {
     a.choice("state_source", state_source, stateSourceNames());
     a("camera_rate_hz", camera_rate_hz);
     a("goal_radius_m", goal_radius_m);
+    a("max_drift_ratio", max_drift_ratio);
     a("pipeline", pipeline);
     a("flight", flight);
     a("imu", imu);

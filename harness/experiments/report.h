@@ -22,7 +22,7 @@ namespace tgnav::harness {
 
 // Trial outcomes as metrics.json and index.csv spell them.
 inline const std::vector<std::string>& trialStatusNames() {
-  static const std::vector<std::string> names = {"success",  "vo_lost", "collision",
+  static const std::vector<std::string> names = {"success",  "drifted", "vo_lost",    "collision",
                                                  "diverged", "timeout", "plan_failed"};
   return names;
 }
@@ -110,8 +110,9 @@ struct TableRow {
   std::string label;
   int trials = 0;                                     // finished
   int successes = 0;                                  // status success
+  int drifted = 0;                                    // status drifted
   std::optional<Summary> length_m;                    // flown length, trials that flew (not plan_failed)
-  std::optional<Summary> goal_error_m;                // successful trials only
+  std::optional<Summary> goal_error_m;                // trials whose VO tracked to the goal (success, drifted)
   std::optional<Summary> plan_time_s;                 // all trials with a plan time
   std::optional<Summary> ate_rmse_m;                  // trials with tracked frames
   std::vector<std::pair<std::string, int>> outcomes;  // status -> count, trialStatusNames() order

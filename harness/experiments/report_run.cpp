@@ -149,6 +149,7 @@ nlohmann::json reportJson(const SweepIndex& sweep, const std::vector<ReportGroup
                            {"samples", group.samples},
                            {"params", group.params},
                            {"successes", t.successes},
+                           {"drifted", t.drifted},
                            {"length_m", summaryJson(t.length_m)},
                            {"goal_error_m", summaryJson(t.goal_error_m)},
                            {"plan_time_s", summaryJson(t.plan_time_s)},

@@ -9,6 +9,7 @@
 
 #include "control/state_estimator.h"
 #include "harness/base/errors.h"
+#include "harness/run/trial_metrics.h"
 #include "harness/run/vo_pipeline.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
@@ -297,7 +298,11 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   }
   result.setpoints = setpoints(result.plan, scenario.planner.trajectory.sample_rate_hz);
   ClosedLoop closed_loop(scenario, options, *result.setpoints, &result);
-  const TrialVerdict verdict = decideStatus(closed_loop.fly(progress, interrupt));
+  TrialEvents events = closed_loop.fly(progress, interrupt);
+  events.goal_error_m = trackedGoalError(result.frames);
+  events.path_length_m = flownLength(result.flight);
+  events.max_drift_ratio = scenario.trial.max_drift_ratio;
+  const TrialVerdict verdict = decideStatus(events);
   result.status = verdict.status;
   result.detail = verdict.detail;
   const planner::PerceptionPlannerConfig& model = scenario.planner.perception;

@@ -1,6 +1,7 @@
 #include "harness/run/trial_job.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <opencv2/core/utility.hpp>
 #include <sstream>
@@ -62,7 +63,8 @@ std::string voCsv(const TrialResult& r) {
   out.precision(6);
   out << std::fixed;
   out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
-         "predicted_score,predicted_landmarks,predicted_coverage,reason\n";
+         "predicted_score,predicted_landmarks,predicted_coverage,ba_correction_m,ba_correction_rad,ba_outliers,"
+         "reason\n";
   for (const TrialFrame& f : r.frames) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
     const Eigen::Vector3d e = f.vo.X_WC.translation();
@@ -74,7 +76,12 @@ std::string voCsv(const TrialResult& r) {
     } else {
       out << ",,";
     }
-    out << ',' << f.predicted.score << ',' << f.predicted.landmarks << ',' << f.predicted.coverage;
+    out << ',' << f.predicted.score << ',' << f.predicted.landmarks << ',' << f.predicted.coverage << ',';
+    if (std::isfinite(f.vo.ba_correction_m)) {  // keyframes that bundle adjustment refined
+      out << f.vo.ba_correction_m << ',' << f.vo.ba_correction_rad << ',' << f.vo.ba_outliers;
+    } else {
+      out << ",,";
+    }
     std::string reason = f.vo.reason;
     for (char& c : reason) c = (c == ',' || c == '\n') ? ';' : c;
     out << ',' << reason << '\n';

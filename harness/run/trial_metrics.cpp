@@ -18,14 +18,30 @@ std::vector<vo::StampedPose> cameraPoses(const FlightResult& flight, const Eigen
   return poses;
 }
 
+double flownLength(const FlightResult& flight) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < flight.log.size(); ++i) {
+    length += (flight.log[i].state.p_WB - flight.log[i - 1].state.p_WB).norm();
+  }
+  return length;
+}
+
+// The goal error needs an estimate at the end of the flight.
+std::optional<double> trackedGoalError(const std::vector<TrialFrame>& frames) {
+  if (frames.empty() || !frames.back().tracked()) return std::nullopt;
+  std::vector<vo::PosePair> pairs;
+  for (const TrialFrame& f : frames) {
+    if (f.tracked()) pairs.push_back(vo::PosePair{f.vo.t_s, f.vo.X_WC, f.X_WC_true});
+  }
+  return vo::goalError(pairs);
+}
+
 TrialScores scoreTrial(const TrialResult& result) {
   TrialScores s;
   const planner::Plan& plan = result.plan.plan;
   if (plan.chosen >= 0) s.planned_length_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].length_m;
   s.trajectory_length_m = result.plan.trajectory.length_m;
-  for (std::size_t i = 1; i < result.flight.log.size(); ++i) {
-    s.path_length_m += (result.flight.log[i].state.p_WB - result.flight.log[i - 1].state.p_WB).norm();
-  }
+  s.path_length_m = flownLength(result.flight);
 
   std::vector<vo::PosePair> pairs;
   double distance = 0.0;
@@ -53,10 +69,7 @@ TrialScores scoreTrial(const TrialResult& result) {
     s.ate_anchored_rmse_m = anchored.rmse_m;
     s.ate_max_m = anchored.max_m;
     s.ate_rmse_m = vo::absoluteTrajectoryError(pairs, true).rmse_m;
-    // The goal error needs an estimate at the end of the flight.
-    if (result.frames.back().tracked() && result.status != TrialStatus::kInterrupted) {
-      s.goal_error_m = vo::goalError(pairs);
-    }
+    if (result.status != TrialStatus::kInterrupted) s.goal_error_m = trackedGoalError(result.frames);
   }
   return s;
 }

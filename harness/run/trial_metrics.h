@@ -26,6 +26,12 @@ struct TrialScores {
 };
 TrialScores scoreTrial(const TrialResult& result);
 
+// The pieces of the score the trial's status needs (trial.cpp decides `drifted` with them):
+// the length of the flown body path, and the VO's goal error over the frames (none when the
+// last frame was not tracked).
+double flownLength(const FlightResult& flight);
+std::optional<double> trackedGoalError(const std::vector<TrialFrame>& frames);
+
 // metrics.json: the fields the README documents, the wall-clock ones (plan_time_s, wall_time_s,
 // real_time_factor, peak_rss_mb) also under `timing`, which holds every wall-clock figure;
 // everything outside `timing` and those four is deterministic for a scenario and seed.

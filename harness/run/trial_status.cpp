@@ -1,5 +1,6 @@
 #include "harness/run/trial_status.h"
 
+#include <algorithm>
 #include <sstream>
 
 namespace tgnav::harness {
@@ -8,6 +9,8 @@ const char* toString(TrialStatus status) {
   switch (status) {
     case TrialStatus::kSuccess:
       return "success";
+    case TrialStatus::kDrifted:
+      return "drifted";
     case TrialStatus::kVoLost:
       return "vo_lost";
     case TrialStatus::kCollision:
@@ -60,6 +63,11 @@ TrialVerdict decideStatus(const TrialEvents& e) {
     v.status = TrialStatus::kTimeout;
     why << "the flight ended " << e.final_distance_to_goal_m << " m from the goal (goal radius " << e.goal_radius_m
         << " m)";
+  } else if (e.goal_error_m && *e.goal_error_m > e.max_drift_ratio * e.path_length_m) {
+    v.status = TrialStatus::kDrifted;
+    why << "reached the goal (" << e.final_distance_to_goal_m << " m from it), but the VO ended " << *e.goal_error_m
+        << " m off, " << 100.0 * *e.goal_error_m / std::max(e.path_length_m, 1e-9) << " % of the " << e.path_length_m
+        << " m flown (bound " << 100.0 * e.max_drift_ratio << " %)";
   } else {
     v.status = TrialStatus::kSuccess;
     why << "reached the goal (" << e.final_distance_to_goal_m << " m from it) with VO tracking all " << e.frames

@@ -7,8 +7,8 @@
 
 namespace tgnav::harness {
 
-enum class TrialStatus { kSuccess, kVoLost, kCollision, kDiverged, kTimeout, kPlanFailed, kInterrupted };
-const char* toString(TrialStatus status);  // "success", "vo_lost", ..., "incomplete"
+enum class TrialStatus { kSuccess, kDrifted, kVoLost, kCollision, kDiverged, kTimeout, kPlanFailed, kInterrupted };
+const char* toString(TrialStatus status);  // "success", "drifted", "vo_lost", ..., "incomplete"
 
 struct TrialEvent {
   double t_s = 0.0;
@@ -29,6 +29,11 @@ struct TrialEvents {
   double sim_time_s = 0.0;
   double planned_end_s = 0.0;
   int frames = 0;  // VO frames scored
+  // The VO's goal error (|estimated - true| final camera position, anchored at take-off; none
+  // when the last frame was not tracked), the distance flown, and the bound on their ratio.
+  std::optional<double> goal_error_m;
+  double path_length_m = 0.0;
+  double max_drift_ratio = 0.01;
 };
 
 struct TrialVerdict {
@@ -37,7 +42,9 @@ struct TrialVerdict {
 };
 
 // Most severe first: interrupted, collision, diverged (or left the scene), VO lost, timeout (the
-// flight ended outside the goal radius), success.
+// flight ended outside the goal radius), drifted (the VO tracked to the end, but its goal error
+// exceeds max_drift_ratio times the distance flown: the vehicle arrived without knowing where it
+// was), success.
 TrialVerdict decideStatus(const TrialEvents& events);
 
 // "(x, y, z)" with 2 decimals, as details and messages print positions.

@@ -242,22 +242,41 @@ TEST(ReportAggregation, MarkdownLayoutFollowsTableTwo) {
   EXPECT_EQ(lines[2], "4 of 5 trials finished.");
   // Header, alignment row, one row per group, the scene named once per block.
   EXPECT_EQ(lines[4],
-            "| Scene     | Planner  | Trials | Length (m) | Goal error (m)* | VO success | Plan time (s) |"
+            "| Scene     | Planner  | Trials | Length (m) | Goal error (m)* | VO success | Drifted | Plan time (s) |"
             "    ATE RMSE (m) | Outcomes  |");
   EXPECT_EQ(lines[5],
-            "| --------- | -------- | -----: | ---------: | --------------: | ---------: | ------------: |"
+            "| --------- | -------- | -----: | ---------: | --------------: | ---------: | ------: | ------------: |"
             " --------------: | --------- |");
   EXPECT_EQ(lines[6],
-            "| *storage* | Proposed |      2 | 16.0 ± 0.1 |   0.118 ± 0.025 |        2/2 |   1.60 ± 0.14 |"
+            "| *storage* | Proposed |      2 | 16.0 ± 0.1 |   0.118 ± 0.025 |        2/2 |     0/2 |   1.60 ± 0.14 |"
             " 0.0300 ± 0.0141 | 2 success |");
   // One trial: the mean alone, to 3 significant figures; no goal error without a success.
   EXPECT_EQ(lines[7],
-            "|           | AP       |      1 |       10.0 |               – |        0/1 |          1.00 |"
+            "|           | AP       |      1 |       10.0 |               – |        0/1 |     0/1 |          1.00 |"
             "          0.0500 | 1 vo_lost |");
   EXPECT_EQ(lines[8],
-            "| *gallery* | R-15000  |      1 |       10.0 |           0.100 |        1/1 |           164 |"
+            "| *gallery* | R-15000  |      1 |       10.0 |           0.100 |        1/1 |     0/1 |           164 |"
             "          0.0500 | 1 success |");
-  EXPECT_NE(lines[10].find("over successful trials only"), std::string::npos);
+  EXPECT_NE(lines[10].find("over the trials whose VO tracked to the goal (success and drifted"), std::string::npos);
+}
+
+// A drifted trial is not a success, is counted in its own column, and its goal error counts:
+// leaving it out would flatter the group's goal error.
+TEST(ReportAggregation, DriftedTrialsAreCountedApartAndInTheGoalError) {
+  const fs::path dir = tempDir();
+  Row p1 = row("p1"), p2 = row("p2");
+  p1.goal = "0.1";
+  p2.goal = "0.5";
+  p2.status = "drifted";
+  const SweepIndex sweep = readSweep(makeSweep(dir, {p1, p2}));
+  const auto table = tableRows(groupTrials(sweep.rows), sweep.rows);
+  ASSERT_EQ(table.size(), 1u);
+  EXPECT_EQ(table[0].successes, 1);
+  EXPECT_EQ(table[0].drifted, 1);
+  ASSERT_TRUE(table[0].goal_error_m);
+  EXPECT_EQ(table[0].goal_error_m->n, 2);
+  EXPECT_DOUBLE_EQ(table[0].goal_error_m->mean, 0.3);
+  EXPECT_EQ(formatOutcomes(table[0].outcomes), "1 success, 1 drifted");
 }
 
 TEST(ReportAggregation, CsvHasRawNumbersInSeparateColumns) {
@@ -276,8 +295,8 @@ TEST(ReportAggregation, CsvHasRawNumbersInSeparateColumns) {
   EXPECT_EQ(header,
             "scene,planner,samples,params,label,trials,successes,vo_success_rate,length_n,length_mean_m,length_std_m,"
             "goal_error_n,goal_error_mean_m,goal_error_std_m,plan_time_n,plan_time_mean_s,plan_time_std_s,ate_n,"
-            "ate_rmse_mean_m,ate_rmse_std_m,success,vo_lost,collision,diverged,timeout,plan_failed");
-  EXPECT_EQ(line, "storage,proposed,0,,Proposed,2,1,0.5,2,1.5,0.7071067812,1,0.1,0,2,1,0,2,0.05,0,1,0,0,0,1,0");
+            "ate_rmse_mean_m,ate_rmse_std_m,success,drifted,vo_lost,collision,diverged,timeout,plan_failed");
+  EXPECT_EQ(line, "storage,proposed,0,,Proposed,2,1,0.5,2,1.5,0.7071067812,1,0.1,0,2,1,0,2,0.05,0,1,0,0,0,0,1,0");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -316,7 +335,7 @@ TEST(ReportBadInput, RowErrorsNameFileLineAndColumn) {
   EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column path_length_m: 'nan' is not a number"), std::string::npos);
   r = row("b");
   r.status = "crashed";
-  EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column status: 'crashed' is not one of success, vo_lost"),
+  EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column status: 'crashed' is not one of success, drifted, vo_lost"),
             std::string::npos);
   r = row("b");
   r.planner = "astar";

@@ -35,6 +35,30 @@ TEST(DecideStatus, EndingOutsideTheGoalRadiusIsATimeout) {
   EXPECT_EQ(decideStatus(e).status, TrialStatus::kSuccess);
 }
 
+// A VO that tracked to the end but ended further off than max_drift_ratio of the distance
+// flown: drifted, not success. On the bound counts as success; a timeout beats drifted, and no
+// goal error (the last frame untracked) cannot drift.
+TEST(DecideStatus, GoalErrorBeyondTheDriftBoundIsDrifted) {
+  TrialEvents e = clean();
+  e.path_length_m = 40.0;
+  e.max_drift_ratio = 0.01;
+  e.goal_error_m = 0.41;
+  TrialVerdict v = decideStatus(e);
+  EXPECT_EQ(v.status, TrialStatus::kDrifted);
+  EXPECT_STREQ(toString(v.status), "drifted");
+  EXPECT_EQ(v.detail,
+            "reached the goal (0.10 m from it), but the VO ended 0.41 m off, 1.02 % of the 40.00 m flown (bound "
+            "1.00 %)");
+  e.goal_error_m = 0.4;
+  EXPECT_EQ(decideStatus(e).status, TrialStatus::kSuccess);
+  e.goal_error_m = 3.0;
+  e.final_distance_to_goal_m = 0.6;
+  EXPECT_EQ(decideStatus(e).status, TrialStatus::kTimeout);
+  e = clean();
+  e.path_length_m = 40.0;
+  EXPECT_EQ(decideStatus(e).status, TrialStatus::kSuccess);
+}
+
 TEST(DecideStatus, VoLossBeatsTimeoutAndSuccess) {
   TrialEvents e = clean();
   e.vo_lost = event(4.0, "17 matches < 30");

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -40,7 +41,9 @@ TEST(Odometry, TracksASidewaysSlideOverATexturedPlane) {
     const FrameResult r = vo.track(0.05 * i, image, flatDepth());
     ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
     const double truth = 4.0 * i * kDepth / kF;
-    EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 2e-3) << "frame " << i;
+    // One plane 2 m ahead leaves yaw and sideways translation weakly separable: a keyframe's few
+    // millimetres of error (~0.5 px) carry over to the frames tracked against its landmarks.
+    EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 8e-3) << "frame " << i;
     // A single plane leaves rotation and sideways translation weakly separable: small drift.
     EXPECT_NEAR(r.X_WC.translation().y(), 0.0, 0.005 + 0.005 * truth) << "frame " << i;
     EXPECT_NEAR(r.X_WC.translation().z(), 0.0, 0.01 + 0.01 * truth) << "frame " << i;
@@ -51,6 +54,37 @@ TEST(Odometry, TracksASidewaysSlideOverATexturedPlane) {
   }
   EXPECT_FALSE(vo.failed());
   EXPECT_GT(vo.history().back().features, 500);
+}
+
+// Bundle adjustment runs on keyframes (not on the first, which has nothing to adjust against)
+// and reports what it changed there; with ba.enabled = false nothing is reported. Both track the
+// slide; on exact depth BA's corrections are small.
+TEST(Odometry, BundleAdjustmentRefinesKeyframesOnly) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  for (const bool ba : {true, false}) {
+    OdometryConfig config;
+    config.ba.enabled = ba;
+    RgbdOdometry vo(camera(), config);
+    int adjusted = 0;
+    for (int i = 0; i < 100; ++i) {
+      const FrameResult r = vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth());
+      ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+      const double truth = 4.0 * i * kDepth / kF;
+      EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 8e-3) << "frame " << i << ", ba " << ba;
+      if (!std::isfinite(r.ba_correction_m)) continue;
+      ++adjusted;
+      EXPECT_TRUE(ba);
+      EXPECT_TRUE(r.keyframe) << "frame " << i;
+      EXPECT_GT(i, 0);
+      EXPECT_LT(r.ba_correction_m, 0.02) << "frame " << i;
+      EXPECT_LT(r.ba_correction_rad, 0.01) << "frame " << i;
+    }
+    if (ba) {
+      EXPECT_GE(adjusted, 5);  // 2.8 m of slide: a keyframe every 0.4 m at least
+    } else {
+      EXPECT_EQ(adjusted, 0);
+    }
+  }
 }
 
 TEST(Odometry, BlankSaturatedOrDepthlessFramesAreLost) {
@@ -132,6 +166,9 @@ TEST(Odometry, BadFramesAndConfigsAreRefused) {
   c = OdometryConfig{};
   c.ratio_test = 1.5;
   EXPECT_NE(message(c).find("ratio_test"), std::string::npos);
+  c = OdometryConfig{};
+  c.ba.max_iterations = 0;
+  EXPECT_NE(message(c).find("ba.max_iterations = 0"), std::string::npos);
   EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
 }
 

@@ -1,0 +1,192 @@
+// Local bundle adjustment on synthetic windows: keyframes along a path looking at landmarks
+// spread in front of them, observed exactly (pixels and depth); perturbed poses and landmarks
+// must come back to the truth, outliers must be found, the gauge must not move.
+#include "vo/bundle_adjustment.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace tgnav::vo {
+namespace {
+
+const CameraIntrinsics kCamera{640, 480, 500.0, 500.0, 319.5, 239.5};
+
+struct Window {
+  std::vector<Eigen::Isometry3d> X_CW_true;
+  std::vector<Eigen::Vector3d> p_W_true;
+  BaProblem problem;
+};
+
+// `keyframes` cameras 0.3 m apart along world x, looking along +z; landmarks 2-6 m ahead; every
+// landmark each keyframe sees in its image is observed (with depth when `depth`).
+Window makeWindow(int keyframes, int landmarks, bool depth, unsigned seed) {
+  Window w;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> x(-2.0, 3.0), y(-1.5, 1.5), z(2.0, 6.0);
+  for (int k = 0; k < keyframes; ++k) {
+    Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+    X_WC.translation() = Eigen::Vector3d(0.3 * k, 0.02 * k, 0.0);
+    X_WC.linear() = Eigen::AngleAxisd(0.03 * k, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    w.X_CW_true.push_back(X_WC.inverse());
+  }
+  for (int l = 0; l < landmarks; ++l) w.p_W_true.emplace_back(x(rng), y(rng), z(rng));
+  for (int k = 0; k < keyframes; ++k) {
+    for (int l = 0; l < landmarks; ++l) {
+      const Eigen::Vector3d q = w.X_CW_true[static_cast<std::size_t>(k)] * w.p_W_true[static_cast<std::size_t>(l)];
+      if (q.z() < 0.5) continue;
+      const Eigen::Vector2d uv(kCamera.fx * q.x() / q.z() + kCamera.cx, kCamera.fy * q.y() / q.z() + kCamera.cy);
+      if (uv.x() < 0 || uv.y() < 0 || uv.x() > kCamera.width_px - 1 || uv.y() > kCamera.height_px - 1) continue;
+      BaObservation o;
+      o.keyframe = k;
+      o.landmark = l;
+      o.uv = uv;
+      o.depth_m = depth ? q.z() : 0.0;
+      w.problem.observations.push_back(o);
+    }
+  }
+  w.problem.X_CW = w.X_CW_true;
+  w.problem.fixed.assign(static_cast<std::size_t>(keyframes), false);
+  w.problem.fixed[0] = true;
+  w.problem.p_W = w.p_W_true;
+  return w;
+}
+
+// Moves every free pose by ~`t` m and ~`r` rad and every landmark by ~`p` m.
+void perturb(BaProblem* problem, double t, double r, double p, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (std::size_t k = 0; k < problem->X_CW.size(); ++k) {
+    if (problem->fixed[k]) continue;
+    Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+    d.translation() = t * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    d.linear() = Eigen::AngleAxisd(r, Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized()).toRotationMatrix();
+    problem->X_CW[k] = d * problem->X_CW[k];
+  }
+  for (Eigen::Vector3d& q : problem->p_W) q += p * Eigen::Vector3d(n(rng), n(rng), n(rng));
+}
+
+double poseError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return (a.inverse().translation() - b.inverse().translation()).norm();
+}
+
+TEST(BundleAdjustment, RecoversPerturbedPosesAndLandmarksWithDepth) {
+  Window w = makeWindow(5, 300, /*depth=*/true, 1);
+  perturb(&w.problem, 0.05, 0.02, 0.05, 2);
+  const Eigen::Isometry3d fixed_before = w.problem.X_CW[0];
+  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  ASSERT_TRUE(report.solved);
+  EXPECT_EQ(report.outliers, 0);
+  EXPECT_LT(report.final_cost, 1e-6 * report.initial_cost);
+  EXPECT_TRUE(w.problem.X_CW[0].matrix() == fixed_before.matrix());  // the gauge, bit for bit
+  for (std::size_t k = 1; k < w.X_CW_true.size(); ++k) {
+    EXPECT_LT(poseError(w.problem.X_CW[k], w.X_CW_true[k]), 1e-4) << "keyframe " << k;
+    EXPECT_LT(Eigen::AngleAxisd(w.problem.X_CW[k].linear() * w.X_CW_true[k].linear().transpose()).angle(), 1e-5);
+  }
+  std::vector<bool> observed(w.p_W_true.size(), false);
+  for (const BaObservation& o : w.problem.observations) observed[static_cast<std::size_t>(o.landmark)] = true;
+  for (std::size_t l = 0; l < w.p_W_true.size(); ++l) {
+    if (!observed[l]) continue;  // not in the problem: left as it was
+    EXPECT_LT((w.problem.p_W[l] - w.p_W_true[l]).norm(), 1e-3) << "landmark " << l;
+  }
+}
+
+// Without depth, two fixed keyframes set the scale (monocular BA's gauge).
+TEST(BundleAdjustment, ReprojectionAloneConvergesWithTwoFixedKeyframes) {
+  Window w = makeWindow(5, 300, /*depth=*/false, 3);
+  w.problem.fixed[1] = true;
+  perturb(&w.problem, 0.02, 0.01, 0.02, 4);
+  BundleAdjustmentConfig config;
+  config.max_iterations = 50;
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config);
+  ASSERT_TRUE(report.solved);
+  for (std::size_t k = 2; k < w.X_CW_true.size(); ++k) {
+    EXPECT_LT(poseError(w.problem.X_CW[k], w.X_CW_true[k]), 1e-3) << "keyframe " << k;
+  }
+}
+
+// Observations moved 40 px off (mismatches) are flagged and do not pull the poses.
+TEST(BundleAdjustment, FlagsGrossOutliersAndIgnoresThem) {
+  Window w = makeWindow(5, 300, /*depth=*/true, 5);
+  std::vector<bool> corrupted(w.problem.observations.size(), false);
+  for (std::size_t i = 7; i < w.problem.observations.size(); i += 25) {
+    w.problem.observations[i].uv += Eigen::Vector2d(40.0, -25.0);
+    corrupted[i] = true;
+  }
+  perturb(&w.problem, 0.03, 0.01, 0.0, 6);
+  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  ASSERT_TRUE(report.solved);
+  int caught = 0, false_alarms = 0;
+  for (std::size_t i = 0; i < corrupted.size(); ++i) {
+    if (report.outlier[i] && corrupted[i]) ++caught;
+    if (report.outlier[i] && !corrupted[i]) ++false_alarms;
+  }
+  const int planted = static_cast<int>(std::count(corrupted.begin(), corrupted.end(), true));
+  EXPECT_EQ(caught, planted) << "iterations " << report.iterations << " cost " << report.initial_cost << " -> "
+                             << report.final_cost;
+  EXPECT_LE(false_alarms, planted / 10);
+  EXPECT_EQ(report.outliers, caught + false_alarms);
+  for (std::size_t k = 1; k < w.X_CW_true.size(); ++k) {
+    EXPECT_LT(poseError(w.problem.X_CW[k], w.X_CW_true[k]), 2e-3) << "keyframe " << k;
+  }
+}
+
+// A keypoint on a coarse pyramid level (large sigma) weighs less: the same pixel error is not an
+// outlier there.
+TEST(BundleAdjustment, CoarseKeypointsAreWeightedByTheirScale) {
+  Window w = makeWindow(3, 200, /*depth=*/true, 7);
+  for (BaObservation& o : w.problem.observations) {
+    if (o.keyframe == 2 && o.landmark % 2 == 0) {
+      o.uv += Eigen::Vector2d(3.0, 0.0);
+      o.sigma_px = 1.2 * 1.2 * 1.2 * 1.2 * 1.2 * 1.2;  // octave 6
+    }
+  }
+  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  ASSERT_TRUE(report.solved);
+  EXPECT_EQ(report.outliers, 0);
+}
+
+TEST(BundleAdjustment, NothingToDoWithoutAFreeKeyframe) {
+  Window w = makeWindow(3, 50, true, 8);
+  w.problem.fixed.assign(3, true);
+  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  EXPECT_FALSE(report.solved);
+  EXPECT_EQ(report.outliers, 0);
+}
+
+TEST(BundleAdjustment, RefusesBadIndicesAndConfigs) {
+  Window w = makeWindow(3, 50, true, 9);
+  w.problem.observations[0].landmark = 50;
+  EXPECT_THROW(bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{}), std::invalid_argument);
+  w = makeWindow(3, 50, true, 9);
+  w.problem.fixed.pop_back();
+  EXPECT_THROW(bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{}), std::invalid_argument);
+  BundleAdjustmentConfig bad;
+  bad.virtual_baseline_m = 0.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = BundleAdjustmentConfig{};
+  bad.depth_sigma_px = -1.0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+  bad = BundleAdjustmentConfig{};
+  bad.fixed_keyframes = 0;
+  EXPECT_THROW(bad.validate(), std::invalid_argument);
+}
+
+// The same problem gives the same result, bit for bit (one thread, fixed ordering).
+TEST(BundleAdjustment, Deterministic) {
+  Window a = makeWindow(5, 200, true, 10);
+  perturb(&a.problem, 0.05, 0.02, 0.05, 11);
+  Window b = a;
+  bundleAdjust(&a.problem, kCamera, BundleAdjustmentConfig{});
+  bundleAdjust(&b.problem, kCamera, BundleAdjustmentConfig{});
+  for (std::size_t k = 0; k < a.problem.X_CW.size(); ++k) {
+    EXPECT_TRUE(a.problem.X_CW[k].matrix() == b.problem.X_CW[k].matrix());
+  }
+  for (std::size_t l = 0; l < a.problem.p_W.size(); ++l) EXPECT_TRUE(a.problem.p_W[l] == b.problem.p_W[l]);
+}
+
+}  // namespace
+}  // namespace tgnav::vo

@@ -1,0 +1,85 @@
+#pragma once
+// Local bundle adjustment over a window of keyframes (Ceres): the keyframes' poses and the
+// landmarks they observe are refined together, ORB-SLAM2's local BA for an RGB-D camera.
+//
+// Each observation of landmark p_W by keyframe k contributes the reprojection residual
+//   ((u, v) - pi(X_CW_k p_W)) / sigma,   sigma = scale_factor^octave
+// (a keypoint found on a coarser pyramid level is located less precisely) and, when the keypoint
+// had a depth z_obs, a disparity residual
+//   (bf / z - bf / z_obs) / depth_sigma_px,   bf = fx * virtual_baseline_m,
+// with z the landmark's depth in keyframe k: ORB-SLAM2's virtual-stereo coordinate
+// u_R = u - bf / z less its u part, so that depth noise and keypoint localisation have sigmas of
+// their own. Depth noise sigma_z = k z^2 (structured light, stereo) is a constant disparity noise
+// bf k; ORB-SLAM2 gives u_R the keypoint's sigma (depth_sigma_px = 1 at octave 0).
+// The residuals pass through a Cauchy loss of scale sqrt(5.991) for 2 residuals, sqrt(7.815) for
+// 3 (the chi-square 95 % points ORB-SLAM2 uses). ORB-SLAM2 uses Huber; a mismatch 40 px off still
+// pulls its landmark with Huber's constant gradient far enough that the landmark's good
+// observations fail the test too (BundleAdjustment.FlagsGrossOutliersAndIgnoresThem: 14 false
+// alarms for 17 mismatches), Cauchy's redescending influence does not (none). Fixed keyframes
+// are the gauge (with depth the scale is observable, so one fixed keyframe suffices).
+//
+// After the optimisation an observation whose weighted squared residual exceeds the chi-square
+// point (or whose landmark lies behind the camera) is an outlier; the problem is solved again
+// without the outliers and without the robust loss, and the outliers are those of that final
+// solution (an observation a mismatch had pulled off during the first pass comes back).
+// Deterministic: one thread, a fixed ordering (landmarks eliminated first, Schur complement on
+// the poses).
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "vo/camera_intrinsics.h"
+
+namespace tgnav::vo {
+
+struct BundleAdjustmentConfig {
+  bool enabled = true;               // false: no BA (frame-to-map PnP only), for ablations
+  double virtual_baseline_m = 0.08;  // bf = fx * this, for the depth residual (ORB-SLAM2's)
+  double depth_sigma_px = 0.1;       // sigma of the disparity bf / z, pixels: bf k for depth
+                                     // noise k z^2 (a RealSense D435, k = 0.002, at fx 416,
+                                     // 640x480 with fovy 60 deg: 0.07)
+  int max_iterations = 10;           // Levenberg-Marquardt iterations per pass (two passes)
+  int fixed_keyframes = 20;          // RgbdOdometry: the last keyframes that left the local map,
+                                     // held fixed in the window (the gauge)
+
+  template <typename Archive>
+  void visit(Archive& a) {
+    a("enabled", enabled);
+    a("virtual_baseline_m", virtual_baseline_m);
+    a("depth_sigma_px", depth_sigma_px);
+    a("max_iterations", max_iterations);
+    a("fixed_keyframes", fixed_keyframes);
+  }
+
+  void validate() const;  // std::invalid_argument naming the field (within ba) and value
+};
+
+struct BaObservation {
+  int keyframe = 0;  // index into BaProblem::X_CW
+  int landmark = 0;  // index into BaProblem::p_W
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  double depth_m = 0.0;   // <= 0 or non-finite: no depth (reprojection only)
+  double sigma_px = 1.0;  // the keypoint's scale (scale_factor^octave)
+};
+
+struct BaProblem {
+  std::vector<Eigen::Isometry3d> X_CW;  // per keyframe, optimised in place
+  std::vector<bool> fixed;              // per keyframe
+  std::vector<Eigen::Vector3d> p_W;     // per landmark, optimised in place
+  std::vector<BaObservation> observations;
+};
+
+struct BaReport {
+  bool solved = false;  // false: nothing to optimise (no free keyframe or no observation)
+  int observations = 0;
+  std::vector<bool> outlier;  // per observation
+  int outliers = 0;
+  double initial_cost = 0.0;  // Ceres's cost (1/2 sum of robustified squared residuals)
+  double final_cost = 0.0;
+  int iterations = 0;  // both passes
+};
+
+// Optimises `problem` in place; std::invalid_argument for indices out of range or sizes that do
+// not agree.
+BaReport bundleAdjust(BaProblem* problem, const CameraIntrinsics& camera, const BundleAdjustmentConfig& config);
+
+}  // namespace tgnav::vo
