@@ -132,9 +132,12 @@ BaReport bundleAdjust(BaProblem* problem, const CameraIntrinsics& camera, const 
   if (!any_free) return report;
 
   // Two passes: robust (Cauchy), then plain least squares without the outliers the first exposed.
+  // One loss object per kind of observation, shared by its residuals.
+  ceres::CauchyLoss loss_mono(std::sqrt(kChi2Mono));
+  ceres::CauchyLoss loss_stereo(std::sqrt(kChi2Stereo));
   for (int pass = 0; pass < 2; ++pass) {
     ceres::Problem::Options problem_options;
-    problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
+    problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
     ceres::Problem ceres_problem(problem_options);
     auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
     int blocks = 0;
@@ -148,8 +151,7 @@ BaReport bundleAdjust(BaProblem* problem, const CameraIntrinsics& camera, const 
               ? static_cast<ceres::CostFunction*>(new ceres::AutoDiffCostFunction<ObservationResidual, 3, 6, 3>(
                     new ObservationResidual(residuals[i])))
               : new ceres::AutoDiffCostFunction<ObservationResidual, 2, 6, 3>(new ObservationResidual(residuals[i]));
-      ceres::LossFunction* loss =
-          pass == 0 ? new ceres::CauchyLoss(std::sqrt(residuals[i].with_depth ? kChi2Stereo : kChi2Mono)) : nullptr;
+      ceres::LossFunction* loss = pass == 0 ? (residuals[i].with_depth ? &loss_stereo : &loss_mono) : nullptr;
       ceres_problem.AddResidualBlock(cost, loss, pose, point);
       ++blocks;
     }
