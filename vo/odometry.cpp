@@ -516,9 +516,9 @@ void RgbdOdometry::adjustLocalMap(FrameResult* result) {
   for (std::size_t l = 0; l < landmarks_.size(); ++l) index_of.emplace(landmarks_[l].id, static_cast<int>(l));
 
   BaProblem problem;
-  std::vector<int> landmark_of;             // problem landmark -> landmarks_ index
-  std::unordered_map<int, int> in_problem;  // landmarks_ index -> problem landmark
-  std::vector<std::pair<int, int>> source;  // problem observation -> (window keyframe, observation)
+  std::vector<int> landmark_of;                        // problem landmark -> landmarks_ index
+  std::vector<int> in_problem(landmarks_.size(), -1);  // landmarks_ index -> problem landmark
+  std::vector<std::pair<int, int>> source;             // problem observation -> (window keyframe, observation)
   for (std::size_t k = 0; k < window.size(); ++k) {
     problem.X_CW.push_back(window[k]->X_WC.inverse());
     problem.fixed.push_back(k < fixed);
@@ -526,14 +526,15 @@ void RgbdOdometry::adjustLocalMap(FrameResult* result) {
     for (std::size_t o = 0; o < obs.size(); ++o) {
       const auto found = index_of.find(obs[o].landmark);
       if (found == index_of.end()) continue;  // culled, or gone with its keyframe
-      auto [it, added] = in_problem.emplace(found->second, static_cast<int>(problem.p_W.size()));
-      if (added) {
+      int& j = in_problem[static_cast<std::size_t>(found->second)];
+      if (j < 0) {
+        j = static_cast<int>(problem.p_W.size());
         problem.p_W.push_back(landmarks_[static_cast<std::size_t>(found->second)].p_W);
         landmark_of.push_back(found->second);
       }
       BaObservation b;
       b.keyframe = static_cast<int>(k);
-      b.landmark = it->second;
+      b.landmark = j;
       b.uv = obs[o].uv;
       b.depth_m = obs[o].depth_m;
       b.sigma_px = obs[o].sigma_px;
