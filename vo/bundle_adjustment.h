@@ -18,10 +18,13 @@
 // alarms for 17 mismatches), Cauchy's redescending influence does not (none). Fixed keyframes
 // are the gauge (with depth the scale is observable, so one fixed keyframe suffices).
 //
-// After the optimisation an observation whose weighted squared residual exceeds the chi-square
-// point (or whose landmark lies behind the camera) is an outlier; the problem is solved again
-// without the outliers and without the robust loss, and the outliers are those of that final
-// solution (an observation a mismatch had pulled off during the first pass comes back).
+// After the optimisation (robust_iterations) an observation whose weighted squared residual
+// exceeds the chi-square point (or whose landmark lies behind the camera) is an outlier; the
+// problem is solved again (max_iterations) without the outliers and without the robust loss, and
+// the outliers are those of that final solution (an observation a mismatch had pulled off during
+// the first pass comes back). Jacobians are analytic. A landmark observed once cannot inform a
+// pose (it fits its observation exactly): it is left out of the solver and placed on its
+// observation from the adjusted pose afterwards, which is where the solver would put it.
 // Deterministic: one thread, a fixed ordering (landmarks eliminated first, Schur complement on
 // the poses).
 #include <Eigen/Geometry>
@@ -37,7 +40,8 @@ struct BundleAdjustmentConfig {
   double depth_sigma_px = 0.1;       // sigma of the disparity bf / z, pixels: bf k for depth
                                      // noise k z^2 (a RealSense D435, k = 0.002, at fx 416,
                                      // 640x480 with fovy 60 deg: 0.07)
-  int max_iterations = 10;           // Levenberg-Marquardt iterations per pass (two passes)
+  int robust_iterations = 5;         // Levenberg-Marquardt iterations of the robust pass and
+  int max_iterations = 10;           // of the final pass (ORB-SLAM2's local BA: 5 and 10)
   int fixed_keyframes = 20;          // RgbdOdometry: the last keyframes that left the local map,
                                      // held fixed in the window (the gauge)
 
@@ -46,6 +50,7 @@ struct BundleAdjustmentConfig {
     a("enabled", enabled);
     a("virtual_baseline_m", virtual_baseline_m);
     a("depth_sigma_px", depth_sigma_px);
+    a("robust_iterations", robust_iterations);
     a("max_iterations", max_iterations);
     a("fixed_keyframes", fixed_keyframes);
   }
@@ -81,5 +86,14 @@ struct BaReport {
 // Optimises `problem` in place; std::invalid_argument for indices out of range or sizes that do
 // not agree.
 BaReport bundleAdjust(BaProblem* problem, const CameraIntrinsics& camera, const BundleAdjustmentConfig& config);
+
+// One observation's weighted residuals, as the optimiser sees them: (u, v) and, with depth, the
+// disparity (the returned count, 2 or 3, says how many rows are used), with their analytic
+// Jacobians by the pose parameters (angle-axis of R_CW, then t_CW) and by p_W. For the tests,
+// which check the Jacobians against finite differences.
+int observationResiduals(const CameraIntrinsics& camera, const BaObservation& observation,
+                         const BundleAdjustmentConfig& config, const Eigen::Matrix<double, 6, 1>& pose,
+                         const Eigen::Vector3d& p_W, Eigen::Vector3d* residual, Eigen::Matrix<double, 3, 6>* J_pose,
+                         Eigen::Matrix3d* J_point);
 
 }  // namespace tgnav::vo

@@ -175,6 +175,102 @@ TEST(BundleAdjustment, RefusesBadIndicesAndConfigs) {
   EXPECT_THROW(bad.validate(), std::invalid_argument);
 }
 
+// A landmark observed once is placed on its observation from the adjusted pose (at the observed
+// depth, or without depth at the depth it had), and does not move the poses.
+TEST(BundleAdjustment, LandmarksObservedOnceArePlacedOnTheirObservation) {
+  Window w = makeWindow(5, 200, true, 21);
+  perturb(&w.problem, 0.03, 0.01, 0.03, 22);
+  Window without = w;
+  // Two more landmarks, each seen by keyframe 3 only: one with depth, one without.
+  const std::size_t k = 3;
+  for (bool depth : {true, false}) {
+    BaObservation o;
+    o.keyframe = static_cast<int>(k);
+    o.landmark = static_cast<int>(w.problem.p_W.size());
+    o.uv = Eigen::Vector2d(depth ? 100.0 : 500.0, 300.0);
+    o.depth_m = depth ? 4.0 : 0.0;
+    w.problem.observations.push_back(o);
+    // Off its ray by ~0.1 m, at 3.5 m in front of the (perturbed) keyframe.
+    w.problem.p_W.push_back(w.problem.X_CW[k].inverse() * Eigen::Vector3d(depth ? -1.3 : 1.2, 0.5, 3.5));
+  }
+  const Eigen::Vector3d before_mono = w.problem.X_CW[k] * w.problem.p_W.back();
+  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  bundleAdjust(&without.problem, kCamera, BundleAdjustmentConfig{});
+  ASSERT_TRUE(report.solved);
+  EXPECT_EQ(report.outliers, 0);
+  for (std::size_t j = 0; j < w.problem.X_CW.size(); ++j) {
+    EXPECT_TRUE(w.problem.X_CW[j].matrix() == without.problem.X_CW[j].matrix()) << "keyframe " << j;
+  }
+  BundleAdjustmentConfig config;
+  for (std::size_t i = w.problem.observations.size() - 2; i < w.problem.observations.size(); ++i) {
+    const BaObservation& o = w.problem.observations[i];
+    const Eigen::Vector3d& p_W = w.problem.p_W[static_cast<std::size_t>(o.landmark)];
+    const Eigen::Vector3d q = w.problem.X_CW[k] * p_W;
+    const double u = kCamera.fx * q.x() / q.z() + kCamera.cx, v = kCamera.fy * q.y() / q.z() + kCamera.cy;
+    EXPECT_NEAR(u, o.uv.x(), 1e-9);
+    EXPECT_NEAR(v, o.uv.y(), 1e-9);
+    EXPECT_NEAR(q.z(), o.depth_m > 0.0 ? o.depth_m : before_mono.z(), 1e-9);
+  }
+}
+
+// The analytic Jacobians equal central differences, at rotations of every size (zero, below the
+// series threshold, large), with and without depth, at a coarse octave.
+TEST(BundleAdjustment, AnalyticJacobiansMatchFiniteDifferences) {
+  BundleAdjustmentConfig config;
+  const Eigen::Vector3d axes[] = {Eigen::Vector3d(0.3, -0.5, 0.8).normalized(), Eigen::Vector3d(1, 0, 0)};
+  for (double angle : {0.0, 1e-6, 3e-4, 0.4, 2.9}) {
+    for (const Eigen::Vector3d& axis : axes) {
+      for (bool depth : {true, false}) {
+        Eigen::Matrix<double, 6, 1> pose;
+        pose << angle * axis, 0.2, -0.1, 0.3;
+        const Eigen::Matrix3d R = Eigen::AngleAxisd(angle, axis).toRotationMatrix();
+        // A landmark 3 m in front of the camera, off its axis.
+        const Eigen::Vector3d p_W = R.transpose() * (Eigen::Vector3d(0.7, -0.4, 3.0) - pose.tail<3>());
+        BaObservation o;
+        o.uv = Eigen::Vector2d(400.0, 200.0);
+        o.depth_m = depth ? 2.9 : 0.0;
+        o.sigma_px = 1.44;
+        Eigen::Vector3d r;
+        Eigen::Matrix<double, 3, 6> J_pose;
+        Eigen::Matrix3d J_point;
+        const int n = observationResiduals(kCamera, o, config, pose, p_W, &r, &J_pose, &J_point);
+        ASSERT_EQ(n, depth ? 3 : 2);
+        Eigen::Matrix<double, 3, 6> N_pose;
+        Eigen::Matrix3d N_point;
+        Eigen::Matrix<double, 3, 6> unused_pose;
+        Eigen::Matrix3d unused_point;
+        const double h = 1e-6;
+        for (int i = 0; i < 9; ++i) {
+          Eigen::Matrix<double, 6, 1> pp = pose, pm = pose;
+          Eigen::Vector3d lp = p_W, lm = p_W;
+          if (i < 6) {
+            pp[i] += h;
+            pm[i] -= h;
+          } else {
+            lp[i - 6] += h;
+            lm[i - 6] -= h;
+          }
+          Eigen::Vector3d rp, rm;
+          observationResiduals(kCamera, o, config, pp, lp, &rp, &unused_pose, &unused_point);
+          observationResiduals(kCamera, o, config, pm, lm, &rm, &unused_pose, &unused_point);
+          const Eigen::Vector3d d = (rp - rm) / (2.0 * h);
+          if (i < 6) {
+            N_pose.col(i) = d;
+          } else {
+            N_point.col(i - 6) = d;
+          }
+        }
+        const double scale = std::max(1.0, N_pose.cwiseAbs().maxCoeff());
+        EXPECT_LT((J_pose - N_pose).cwiseAbs().maxCoeff(), 1e-5 * scale) << "angle " << angle << " depth " << depth;
+        EXPECT_LT((J_point - N_point).cwiseAbs().maxCoeff(), 1e-5 * scale) << "angle " << angle << " depth " << depth;
+        if (!depth) {
+          EXPECT_EQ(J_pose.row(2).norm(), 0.0);
+        }
+      }
+    }
+  }
+}
+
 // The same problem gives the same result, bit for bit (one thread, fixed ordering).
 TEST(BundleAdjustment, Deterministic) {
   Window a = makeWindow(5, 200, true, 10);

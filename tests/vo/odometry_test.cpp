@@ -169,6 +169,9 @@ TEST(Odometry, BadFramesAndConfigsAreRefused) {
   c = OdometryConfig{};
   c.ba.max_iterations = 0;
   EXPECT_NE(message(c).find("ba.max_iterations = 0"), std::string::npos);
+  c = OdometryConfig{};
+  c.ba.robust_iterations = 0;
+  EXPECT_NE(message(c).find("ba.robust_iterations = 0"), std::string::npos);
   EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
 }
 
