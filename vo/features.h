@@ -1,6 +1,8 @@
 #pragma once
 // ORB features spread over the image on a grid (ORB-SLAM2's bucketing idea): a textured patch
 // in one corner must not starve the rest of the image of features.
+// The feature maps are built with this detector and cached by their settings: a change to what
+// it detects must bump kMapBuilderVersion (harness/run/map_cache.cpp).
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <vector>

@@ -32,10 +32,17 @@ class Fnv1a {
   std::uint64_t h_ = 0xcbf29ce484222325ULL;
 };
 
+// The map builder's version, part of every map's key: bump it whenever the code changes what a
+// map holds for the same scene and settings (the feature detector, the landmark fusion, the
+// occupancy), or a cached map built by the old code would be taken for a new one. v2: ORB
+// keypoints at the coarse pyramid levels placed where they are (vo/features.cpp, 42d8b18); maps
+// cached before it differ from those a fresh clone builds.
+constexpr const char* kMapBuilderVersion = "tgnav-map-v2";
+
 std::string settingsText(const SceneConfig& scene, const MapBuildConfig& c) {
   std::ostringstream s;
   s.precision(17);
-  s << "tgnav-map-v1\n"
+  s << kMapBuilderVersion << "\n"
     << scene.bounds_min_m.transpose() << ' ' << scene.bounds_max_m.transpose() << '\n'
     << scene.survey.spacing_m << ' ' << scene.survey.yaw_count << ' ' << scene.survey.clearance_m;
   for (double h : scene.survey.heights_m) s << ' ' << h;

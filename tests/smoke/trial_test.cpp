@@ -140,10 +140,12 @@ TEST(SmokeTrial, SameSeedSameMetricsPipelinedOrNot) {
   EXPECT_NE(readText(dir / "a/est.tum"), readText(dir / "c/est.tum"));
 }
 
+// At the scenario's 640x480: at 320x240 the VO drifts 0.2-1.1 % of the distance
+// (docs/results/vo_ba), as near the 1 % drift bound as this 8 m flight on the VO estimate ends
+// (1.04 %, `drifted`), and this test is about flying on the estimate, not about that bound.
 TEST(SmokeTrial, FliesOnTheVoEstimate) {
   const auto out = tempDir() / "trial";
-  const CmdResult run =
-      shell(trialCommand("--planner proposed" + kSmall + " --set trial.state_source=vo --out " + out.string()));
+  const CmdResult run = shell(trialCommand("--planner proposed --set trial.state_source=vo --out " + out.string()));
   ASSERT_EQ(run.rc, 0) << run.output;
   const nlohmann::json m = readJson(out / "metrics.json");
   std::cout << "[ figure   ] smoke on VO: " << m["status"] << ", final distance to goal "
