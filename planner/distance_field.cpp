@@ -88,22 +88,77 @@ double DistanceField::clearance(const Eigen::Vector2d& p_m, Eigen::Vector2d* gra
   return best;
 }
 
+double DistanceField::segmentClearance(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double reach_m) const {
+  // Every square closer than reach_m to the segment has a cell within the segment's box grown by
+  // reach_m; for a segment and a square that do not meet, the nearest pair has a corner of one.
+  const double res = grid_.resolution_m;
+  const Eigen::Vector2i lo = grid_.cellOf(a.cwiseMin(b) - Eigen::Vector2d::Constant(reach_m));
+  const Eigen::Vector2i hi = grid_.cellOf(a.cwiseMax(b) + Eigen::Vector2d::Constant(reach_m));
+  const Eigen::Vector2d ab = b - a;
+  auto pointToSegment = [&](const Eigen::Vector2d& p) {
+    const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+    return (a + t * ab - p).norm();
+  };
+  double best = std::numeric_limits<double>::infinity();
+  for (int iy = lo.y(); iy <= hi.y(); ++iy) {
+    for (int ix = lo.x(); ix <= hi.x(); ++ix) {
+      if (!grid_.isOccupied(ix, iy)) continue;
+      const Eigen::Vector2d sq_lo = grid_.origin_m + res * Eigen::Vector2d(ix, iy);
+      const Eigen::Vector2d sq_hi = sq_lo + Eigen::Vector2d::Constant(res);
+      // Liang-Barsky: does the segment enter the square?
+      double t0 = 0.0;
+      double t1 = 1.0;
+      bool meets = true;
+      for (int k = 0; k < 2 && meets; ++k) {
+        if (std::abs(ab[k]) < 1e-300) {
+          meets = a[k] >= sq_lo[k] && a[k] <= sq_hi[k];
+          continue;
+        }
+        double ta = (sq_lo[k] - a[k]) / ab[k];
+        double tb = (sq_hi[k] - a[k]) / ab[k];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        meets = t0 <= t1;
+      }
+      if (meets) return 0.0;
+      auto toSquare = [&](const Eigen::Vector2d& p) { return (p - p.cwiseMax(sq_lo).cwiseMin(sq_hi)).norm(); };
+      best = std::min({best, toSquare(a), toSquare(b), pointToSegment(sq_lo), pointToSegment(sq_hi),
+                       pointToSegment(Eigen::Vector2d(sq_lo.x(), sq_hi.y())),
+                       pointToSegment(Eigen::Vector2d(sq_hi.x(), sq_lo.y()))});
+    }
+  }
+  return best;
+}
+
 bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const {
-  // Clearance is 1-Lipschitz: every point lies within h/2 of a sample spaced h apart, so
-  // samples with clearance >= clearance_m + h/2 prove the whole segment clear.
+  // Marching from a to b: clearance is 1-Lipschitz, so at a point whose clearance is at least
+  // clearance_m + d the next d metres are clear and can be skipped (sphere tracing); where the
+  // margin is less than a quarter cell, the next quarter cell is measured exactly against the
+  // squares near it.
   const double len = (b - a).norm();
-  const int steps = std::max(1, static_cast<int>(std::ceil(len / (0.5 * grid_.resolution_m))));
-  const double need = clearance_m + 0.5 * len / steps;
+  if (len == 0.0) return clearance(a) >= clearance_m;
+  const Eigen::Vector2d dir = (b - a) / len;
+  const double res = grid_.resolution_m;
+  const double min_step = 0.25 * res;
   // A point is at most 0.71 cells from its cell's centre and an obstacle cell's square reaches
   // 0.71 cells from its own: the centre distance less 1.42 cells bounds the clearance from below.
-  const double slack = 1.4143 * grid_.resolution_m;
-  for (int i = 0; i <= steps; ++i) {
-    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(i) / steps);
+  const double slack = 1.4143 * res;
+  double t = 0.0;
+  while (true) {
+    const Eigen::Vector2d p = a + t * dir;
     const Eigen::Vector2i c = grid_.cellOf(p);
-    if (grid_.inside(c.x(), c.y()) && centreDistance(c.x(), c.y()) - slack >= need) continue;
-    if (clearance(p) < need) return false;
+    double margin = grid_.inside(c.x(), c.y()) ? centreDistance(c.x(), c.y()) - slack - clearance_m : -1.0;
+    if (margin < min_step) margin = clearance(p) - clearance_m;
+    if (margin < 0.0) return false;
+    if (margin < min_step) {
+      const double to = std::min(len, t + min_step);
+      if (segmentClearance(p, a + to * dir, clearance_m) < clearance_m) return false;
+      margin = min_step;
+    }
+    if (t + margin >= len) return true;
+    t += margin;
   }
-  return true;
 }
 
 }  // namespace tgnav::planner

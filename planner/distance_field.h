@@ -26,8 +26,12 @@ class DistanceField {
   // Nearest occupied cell of (ix, iy), in grid coordinates (may be -1 or width/height: the
   // padding ring outside the map).
   Eigen::Vector2i nearestObstacle(int ix, int iy) const;
-  // True if every point of the segment keeps `clearance_m`.
+  // True if every point of the segment keeps `clearance_m` (exact: a path along a corridor whose
+  // clearance is exactly `clearance_m` is clear).
   bool segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const;
+  // Exact distance from a segment to the nearest occupied square, when below `reach_m`
+  // (otherwise some value >= reach_m). Cost grows with the segment's box: for short segments.
+  double segmentClearance(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double reach_m) const;
 
  private:
   std::size_t padded(int ix, int iy) const { return static_cast<std::size_t>(iy + 1) * (grid_.width + 2) + ix + 1; }

@@ -108,7 +108,9 @@ Plan classCandidates(const VoxelMap& voxels, const PerceptionPlannerConfig& conf
   const double z = request.start.p_WB.z();
   plan.flight_height_m = z;
   const OccupancyGrid2D grid = voxels.slice(z - config.slice_half_height_m, z + config.slice_half_height_m);
-  const TopologicalPlanner topo(grid, config.topo);
+  TopoPlannerConfig topo_config = config.topo;
+  topo_config.path_margin_m = voxels.segmentCheckMargin();
+  const TopologicalPlanner topo(grid, topo_config);
   plan.topo = topo.solve(request.start.p_WB.head<2>(), request.goal.p_WB.head<2>());
   plan.status = plan.topo.status;
   if (plan.status != PlanStatus::kSolved) return plan;

@@ -328,8 +328,10 @@ Plan PerceptionRrtStar::solve(const PlanRequest& request) const {
   // without the labelling.
   const double z = request.start.p_WB.z();
   plan.flight_height_m = z;
+  TopoPlannerConfig topo_config = config_.topo;
+  topo_config.path_margin_m = voxels_.segmentCheckMargin();
   const TopologicalPlanner topo(voxels_.slice(z - config_.slice_half_height_m, z + config_.slice_half_height_m),
-                                config_.topo);
+                                topo_config);
   plan.topo = topo.solve(request.start.p_WB.head<2>(), request.goal.p_WB.head<2>());
   for (CandidatePath& c : plan.candidates) {
     std::vector<Eigen::Vector2d> xy;

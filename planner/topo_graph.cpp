@@ -214,6 +214,39 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
     }
   }
 
+  // Within a vertex's cluster, the cells from its chosen cell to any other (breadth-first tree):
+  // an edge leaving the cluster elsewhere goes through them, never straight across (a cluster
+  // need not be convex).
+  std::vector<int> cluster_parent(n_cells, -1);
+  for (const TopoVertex& v : g.vertices) {
+    std::vector<std::size_t> queue{grid.index(v.cell.x(), v.cell.y())};
+    const int id = cluster[queue.front()];
+    cluster_parent[queue.front()] = static_cast<int>(queue.front());
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int x = static_cast<int>(queue[q] % grid.width);
+      const int y = static_cast<int>(queue[q] / grid.width);
+      for (int k = 0; k < 8; ++k) {
+        const int nx = x + kDx8[k];
+        const int ny = y + kDy8[k];
+        if (!mask.at(nx, ny)) continue;
+        const std::size_t j = grid.index(nx, ny);
+        if (cluster[j] != id || cluster_parent[j] >= 0) continue;
+        cluster_parent[j] = static_cast<int>(queue[q]);
+        queue.push_back(j);
+      }
+    }
+  }
+  // Centres from `cell` back to its cluster's chosen cell, both excluded.
+  auto inCluster = [&](const Eigen::Vector2i& cell) {
+    std::vector<Eigen::Vector2d> pts;
+    std::size_t i = grid.index(cell.x(), cell.y());
+    while (cluster_parent[i] >= 0 && static_cast<std::size_t>(cluster_parent[i]) != i) {
+      pts.push_back(grid.centreOf(static_cast<int>(i % grid.width), static_cast<int>(i / grid.width)));
+      i = static_cast<std::size_t>(cluster_parent[i]);
+    }
+    return pts;
+  };
+
   std::vector<std::uint8_t> visited(n_cells, 0);
   auto trace = [&](int from, const Eigen::Vector2i& start_cell, const Eigen::Vector2i& first) {
     std::vector<Eigen::Vector2i> chain{first};
@@ -222,23 +255,31 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
     Eigen::Vector2i cur = first;
     while (true) {
       int end_vertex = -1;
+      Eigen::Vector2i end_cell(-1, -1);
       Eigen::Vector2i next(-1, -1);
       for (int k = 0; k < 8 && end_vertex < 0; ++k) {
         const Eigen::Vector2i c(cur.x() + kDx8[k], cur.y() + kDy8[k]);
         if (!mask.at(c.x(), c.y()) || c == prev) continue;
         const int v = cluster[grid.index(c.x(), c.y())];
-        if (v >= 0 && !(v == from && chain.size() < 3)) end_vertex = v;
+        if (v >= 0 && !(v == from && chain.size() < 3)) {
+          end_vertex = v;
+          end_cell = c;
+        }
       }
       if (end_vertex >= 0) {
         TopoEdge e;
         e.a = from;
         e.b = end_vertex;
         e.points_m.push_back(g.vertices[from].p_m);
+        std::vector<Eigen::Vector2d> lead = inCluster(start_cell);
+        e.points_m.insert(e.points_m.end(), lead.rbegin(), lead.rend());
         double min_clear = 1e18;
         for (const auto& c : chain) {
           e.points_m.push_back(grid.centreOf(c.x(), c.y()));
           min_clear = std::min(min_clear, field.clearance(grid.centreOf(c.x(), c.y())));
         }
+        const std::vector<Eigen::Vector2d> tail = inCluster(end_cell);
+        e.points_m.insert(e.points_m.end(), tail.begin(), tail.end());
         e.points_m.push_back(g.vertices[end_vertex].p_m);
         for (std::size_t i = 1; i < e.points_m.size(); ++i) e.length_m += (e.points_m[i] - e.points_m[i - 1]).norm();
         e.min_clearance_m = std::min(

@@ -63,6 +63,10 @@ class VoxelMap {
   // Every point of the segment keeps `clearance_m` (rigorous: sampled densely enough that
   // the 1-Lipschitz clearance cannot dip between samples).
   bool segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m) const;
+  // How much more than `clearance_m` segmentClear may ask of a point (its samples' half spacing):
+  // paths planned on a slice keep this margin (TopoPlannerConfig::path_margin_m) so that the
+  // check passes them.
+  double segmentCheckMargin() const { return 0.25 * res_; }
 
   // 2D grid at the map's resolution over the box: a cell is blocked when any voxel of its
   // column in [z_lo, z_hi] is occupied or unknown (the flight-height band, like sliceOccupancy).

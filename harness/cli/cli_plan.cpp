@@ -15,6 +15,8 @@ namespace {
 
 struct PlanOptions {
   std::string grid;
+  std::string scen;
+  std::optional<int> bucket;
   std::string scenario;
   std::string start;
   std::string goal;
@@ -32,11 +34,18 @@ struct PlanOptions {
 };
 
 harness::PlanJobResult planGrid(const PlanOptions& opt) {
-  if (opt.start.empty() || opt.goal.empty()) throw InputError("--grid needs --start X,Y and --goal X,Y");
   if (opt.homology_class) throw InputError("--class: only with --scenario (the oracle of a scene's planners)");
   if (!opt.planner.empty() && opt.planner != "agnostic") {
     throw InputError("--planner: '" + opt.planner + "' needs a scene's feature map; with --grid only 'agnostic' runs");
   }
+  if (!opt.scen.empty()) {
+    if (!opt.start.empty() || !opt.goal.empty()) throw InputError("--start/--goal: with --scen, the rows give them");
+    if (opt.bucket && *opt.bucket < 0) throw InputError("--bucket: " + std::to_string(*opt.bucket) + " must be >= 0");
+    return harness::runGridScen(
+        {opt.grid, opt.scen, opt.bucket, opt.resolution_m, opt.robot_radius_m, opt.max_classes, opt.out});
+  }
+  if (opt.bucket) throw InputError("--bucket: only with --scen");
+  if (opt.start.empty() || opt.goal.empty()) throw InputError("--grid needs --start X,Y and --goal X,Y (or --scen)");
   return harness::runGridPlan({opt.grid, opt.start, opt.goal, opt.resolution_m, opt.robot_radius_m, opt.max_classes,
                                opt.out, harness::parseFigureFormat(opt.figure_format)});
 }
@@ -80,6 +89,9 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--map", opt->map, "Feature map folder from `tgnav map` (default: cached by content)");
   cmd->add_option("--map-cache", opt->map_cache,
                   "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
+  cmd->add_option("--scen", opt->scen, "--grid: a MovingAI .scen file: plan every row, write scen.csv and scen.json");
+  auto bucket = std::make_shared<int>(0);
+  cmd->add_option("--bucket", *bucket, "--scen: only the rows of this bucket");
   cmd->add_option("--start", opt->start, "--grid: start X,Y in metres (map frame, y up)");
   cmd->add_option("--goal", opt->goal, "--grid: goal X,Y in metres (map frame, y up)");
   cmd->add_option("--resolution", opt->resolution_m, "--grid: metres per cell of a MovingAI map")
@@ -92,8 +104,10 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--figure-format", opt->figure_format, "png | pdf | svg")->capture_default_str();
   auto homology_class = std::make_shared<int>(0);
   cmd->add_option("--class", *homology_class, "The oracle: plan homology class K (proposed or agnostic)");
-  cmd->callback([opt, cmd, homology_class] {
+  cmd->callback([opt, cmd, homology_class, bucket] {
     if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
+    if (cmd->count("--bucket") > 0) opt->bucket = *bucket;
+    if (!opt->scen.empty() && opt->grid.empty()) throw InputError("--scen: needs --grid MAP (its MovingAI map)");
     if (opt->scenario.empty() == opt->grid.empty()) throw InputError("plan: give one of --scenario FILE or --grid MAP");
     const harness::PlanJobResult r = opt->grid.empty() ? planScenario(*opt) : planGrid(*opt);
     harness::reportFigures("tgnav plan", r.figures);

@@ -11,33 +11,24 @@
 
 #include "harness/base/errors.h"
 #include "harness/config/yaml_util.h"
+#include "harness/io/text_fields.h"
 
 namespace tgnav::harness {
 
 namespace {
 
-// Larger sides are corrupt headers, not maps: refusing them keeps allocations bounded.
-constexpr int kMaxSide = 20000;
+// MovingAI's terrain letters (movingai.com/benchmarks/formats): ground '.', 'G' and swamp 'S' are
+// passable; out of bounds '@', 'O', trees 'T' and water 'W' are not, as the benchmark's optimal
+// lengths assume. Any other letter is an error, never a silent obstacle.
+constexpr const char* kMovingAiTerrain = ".GS@OTW";
+bool movingAiPassable(char c) { return c == '.' || c == 'G' || c == 'S'; }
 
-// `text` quoted for a one-line message: control bytes masked, long values cut.
-std::string shown(const std::string& text) {
-  constexpr std::size_t kMaxShown = 40;
-  std::string out = "'";
-  for (std::size_t i = 0; i < text.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    out += std::isprint(c) ? static_cast<char>(c) : '?';
-  }
-  return out + (text.size() > kMaxShown ? "...'" : "'");
-}
-
-// A decimal integer in [lo, hi], or false (digits only: no sign, no overflow).
-bool parseInt(const std::string& text, int lo, int hi, int& out) {
-  if (text.empty() || text.size() > 9) return false;
-  for (char c : text) {
-    if (!std::isdigit(static_cast<unsigned char>(c))) return false;
-  }
-  out = std::stoi(text);
-  return out >= lo && out <= hi;
+// "" for a row of terrain letters, else what is wrong with it.
+std::string terrainError(const std::string& row) {
+  const std::size_t bad = row.find_first_not_of(kMovingAiTerrain);
+  if (bad == std::string::npos) return "";
+  return "column " + std::to_string(bad) + ": terrain " + shown(row.substr(bad, 1)) + " is not one of '" +
+         kMovingAiTerrain + "'";
 }
 
 std::string readBinaryFile(const std::filesystem::path& file) {
@@ -100,8 +91,8 @@ Pgm readPgm(const std::filesystem::path& file) {
            std::to_string(hi));
     }
   };
-  header("width", kMaxSide, pgm.width);
-  header("height", kMaxSide, pgm.height);
+  header("width", kMaxGridSide, pgm.width);
+  header("height", kMaxGridSide, pgm.height);
   header("maxval", 255, pgm.maxval);
 
   const std::size_t count = static_cast<std::size_t>(pgm.width) * pgm.height;
@@ -197,24 +188,9 @@ planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, doub
     value << resolution_m;
     throw InputError(name + ": MovingAI map resolution has value '" + value.str() + "', expected a finite number > 0");
   }
-  if (!std::filesystem::is_regular_file(file)) throw InputError(name + ": cannot open file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name + ": cannot open file");
-
-  int line_no = 0;
-  const auto fail = [&](const std::string& what) {
-    throw InputError(name + ":" + std::to_string(line_no) + ": " + what);
-  };
-  // The next line without its end-of-line (files may use CRLF), or false at end of file.
-  const auto nextLine = [&](std::string& line) {
-    ++line_no;
-    if (!std::getline(in, line)) {
-      line.clear();
-      return false;
-    }
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return true;
-  };
+  TextLines text(file);
+  const auto fail = [&](const std::string& what) { text.fail(what); };
+  const auto nextLine = [&](std::string& line) { return text.next(line); };
   std::string line;
   const auto header = [&](const std::string& key) {
     std::string value;
@@ -228,8 +204,8 @@ planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, doub
   const auto side = [&](const std::string& key) {
     const std::string value = header(key);
     int n = 0;
-    if (!parseInt(value, 1, kMaxSide, n)) {
-      fail("'" + key + "' has value " + shown(value) + ", expected an integer in 1.." + std::to_string(kMaxSide));
+    if (!parseInt(value, 1, kMaxGridSide, n)) {
+      fail("'" + key + "' has value " + shown(value) + ", expected an integer in 1.." + std::to_string(kMaxGridSide));
     }
     return n;
   };
@@ -250,6 +226,7 @@ planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, doub
       fail("row " + std::to_string(rows.size()) + " " + shown(line) + " has " + std::to_string(line.size()) +
            " characters, expected " + std::to_string(width));
     }
+    if (const std::string bad = terrainError(line); !bad.empty()) fail(bad);
     rows.push_back(line);
   }
   while (nextLine(line)) {
@@ -261,8 +238,7 @@ planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, doub
   planner::OccupancyGrid2D grid(width, height, resolution_m, Eigen::Vector2d::Zero());
   for (int row = 0; row < height; ++row) {
     for (int ix = 0; ix < width; ++ix) {
-      const char c = rows[row][ix];
-      grid.set(ix, height - 1 - row, !(c == '.' || c == 'G' || c == 'S'));
+      grid.set(ix, height - 1 - row, !movingAiPassable(rows[row][ix]));
     }
   }
   return grid;

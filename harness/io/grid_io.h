@@ -17,8 +17,8 @@ namespace tgnav::harness {
 planner::OccupancyGrid2D loadRosMap(const std::filesystem::path& yaml);
 
 // A MovingAI .map ("type octile", "height H", "width W", "map", then H rows of W characters).
-// '.', 'G' and 'S' are passable; every other character, including ones the format does not
-// define, is an obstacle. Origin (0, 0); `resolution_m` must be > 0.
+// '.', 'G' and 'S' are passable; '@', 'O', 'T' and 'W' are obstacles; any other character is an
+// error naming its line and column. Origin (0, 0); `resolution_m` must be > 0.
 planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, double resolution_m);
 
 // By extension: .yaml/.yml -> loadRosMap, .map -> loadMovingAiMap (with movingai_resolution_m).

@@ -38,6 +38,19 @@ struct GridPlanJob {
   FigureFormat figure_format = FigureFormat::kPng;
 };
 
+// Every row of a MovingAI .scen file (or of one bucket) planned on its map: the map's graph is
+// built once, then each row is a query. Writes scen.csv (a row per problem) and scen.json (the
+// summary and timing).
+struct GridScenJob {
+  std::filesystem::path grid;  // the .map
+  std::filesystem::path scen;
+  std::optional<int> bucket;  // only this bucket's rows
+  double resolution_m = 1.0;
+  double robot_radius_m = 0.3;
+  int max_classes = 10;
+  std::filesystem::path out;
+};
+
 struct PlanJobResult {
   std::string summary;  // the line `tgnav plan` prints
   std::string warning;  // a line for stderr, or ""
@@ -48,5 +61,6 @@ struct PlanJobResult {
 // InputError for bad input; an unreachable goal is a result (status no_path).
 PlanJobResult runScenarioPlan(const ScenarioPlanJob& job);
 PlanJobResult runGridPlan(const GridPlanJob& job);
+PlanJobResult runGridScen(const GridScenJob& job);
 
 }  // namespace tgnav::harness

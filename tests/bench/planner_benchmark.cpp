@@ -1,7 +1,10 @@
 // Topological planning (EDT + GVD + graph + homology classes + shortening) on the gallery scene
-// rasterised at 5 cm at flight height: 440 x 400 cells, start and goal from the scene.
+// rasterised at 5 cm at flight height: 440 x 400 cells, start and goal from the scene. And on
+// benchmark-sized grid maps (`tgnav plan --grid`), made by the tests' generators: a map's
+// preprocessing (working grid, distance field, GVD) and then its queries, timed apart.
 #include <benchmark/benchmark.h>
 
+#include "../planner/grid_maps.h"
 #include "harness/config/scene_config.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
@@ -47,6 +50,48 @@ void BM_TopologicalPlanGallery(benchmark::State& state) {
   state.counters["cells"] = static_cast<double>(g.grid.width) * g.grid.height;
 }
 BENCHMARK(BM_TopologicalPlanGallery)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// 0: game-like, 530 x 481 at 1 m, 160 building blocks; 1: 530 x 481 rooms of 12 cells with
+// one-cell doors; 2: a map_server-sized 2000 x 2000 at 0.05 m with 300 blocks. Robot radius 0.3 m.
+planner::OccupancyGrid2D benchGrid(int kind) {
+  using namespace planner::testmaps;
+  if (kind == 0) return gridFromMovingAi(blocksMap(530, 481, 160, 1), 1.0);
+  if (kind == 1) return gridFromMovingAi(roomsMap(530, 481, 12, 1), 1.0);
+  return gridFromMovingAi(blocksMap(2000, 2000, 300, 1), 0.05);
+}
+
+void BM_GridPreprocess(benchmark::State& state) {
+  const planner::OccupancyGrid2D grid = benchGrid(static_cast<int>(state.range(0)));
+  planner::TopoPlannerConfig config;
+  int k = 0;
+  for (auto _ : state) {
+    const planner::TopologicalPlanner planner(grid, config);
+    k = planner.workingFactor();
+  }
+  state.counters["cells"] = static_cast<double>(grid.width) * grid.height;
+  state.counters["working_factor"] = k;
+}
+BENCHMARK(BM_GridPreprocess)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+// Ten random reachable queries per iteration on one preprocessed map: ms per query.
+void BM_GridQuery(benchmark::State& state) {
+  const planner::OccupancyGrid2D grid = benchGrid(static_cast<int>(state.range(0)));
+  planner::TopoPlannerConfig config;
+  const planner::TopologicalPlanner planner(grid, config);
+  const auto queries = planner::testmaps::randomQueries(grid, 10, config.robot_radius_m, 3, /*connected_only=*/true);
+  int solved = 0;
+  for (auto _ : state) {
+    solved = 0;
+    for (const auto& [s, g] : queries) {
+      solved += planner.solve(grid.centreOf(s.x(), s.y()), grid.centreOf(g.x(), g.y())).status ==
+                planner::PlanStatus::kSolved;
+    }
+  }
+  state.counters["ms_per_query"] = benchmark::Counter(static_cast<double>(state.iterations()) * queries.size() / 1000.0,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["solved"] = solved;
+}
+BENCHMARK(BM_GridQuery)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 // Trajectory generation (B-spline position + yaw optimisation, checks) for the shortest gallery
 // class of at least 40 m, with the yaw along the direction of travel, at the default settings.

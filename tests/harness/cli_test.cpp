@@ -249,6 +249,32 @@ TEST(CliPlan, BadStartIsOneLineExit2AndNoPathIsAResult) {
   EXPECT_NE(run.output.find("--planner: 'proposed'"), std::string::npos) << run.output;
 }
 
+TEST(CliPlan, ScenRunsEveryRowAndBadRowsAreOneLineExit2) {
+  const auto dir = test::tempDir();
+  const auto map = twoPillars(dir);
+  // Row 1 goes around the pillars; row 2 starts on one ('@' at column 5, row 5 from the top).
+  const auto scen = test::writeFile(dir / "two.map.scen", "version 1\n0\ttwo.map\t20\t12\t1\t6\t18\t6\t17.0\n");
+  CmdResult run = tgnav("plan --grid " + map.string() + " --scen " + scen.string() + " --robot-radius 0 --out " +
+                        (dir / "s").string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("1 of 1 scenarios found a path"), std::string::npos) << run.output;
+  EXPECT_TRUE(std::filesystem::exists(dir / "s" / "scen.csv"));
+  const auto bad = test::writeFile(dir / "bad.scen", "version 1\n0\ttwo.map\t20\t12\t5\t5\t18\t6\t17.0\n");
+  run = tgnav("plan --grid " + map.string() + " --scen " + bad.string() + " --out " + (dir / "b").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(bad.string() + ":2: start (5, 5) is an obstacle cell"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+  const auto wide = test::writeFile(dir / "wide.scen", "version 1\n0\ttwo.map\t21\t12\t1\t6\t18\t6\t17.0\n");
+  run = tgnav("plan --grid " + map.string() + " --scen " + wide.string() + " --out " + (dir / "w").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find(wide.string() + ":2: map_width has value '21'"), std::string::npos) << run.output;
+  run =
+      tgnav("plan --grid " + map.string() + " --scen " + scen.string() + " --start 1,1 --out " + (dir / "x").string());
+  EXPECT_EQ(run.rc, 2);
+  EXPECT_NE(run.output.find("--start/--goal: with --scen"), std::string::npos) << run.output;
+}
+
 TEST(Cli, UnknownSubcommandExits2AndHelpExits0) {
   const CmdResult bad = tgnav("fly-to-the-moon");
   EXPECT_EQ(bad.rc, 2);

@@ -217,9 +217,8 @@ TEST_F(RosMap, PixelAboveMaxvalIsRejected) {
   EXPECT_NE(word.find("pixel 1 has value 'x'"), std::string::npos) << word;
 }
 
-// 4x3 with a wall ('@'), trees ('T'), a swamp ('S'), a ground alias ('G') and an undefined
-// character ('?'), which counts as an obstacle.
-const std::string kMovingAi = "type octile\nheight 3\nwidth 4\nmap\n@...\n.TS?\nG..@\n";
+// 4x3 with a wall ('@'), trees ('T'), a swamp ('S'), a ground alias ('G') and water ('W').
+const std::string kMovingAi = "type octile\nheight 3\nwidth 4\nmap\n@...\n.TSW\nG..@\n";
 
 class MovingAiMap : public ::testing::Test {
  protected:
@@ -292,8 +291,20 @@ TEST_F(MovingAiMap, BadSideIsRejected) {
   EXPECT_NE(big.find("'width' has value '30000'"), std::string::npos) << big;
 }
 
+TEST_F(MovingAiMap, EveryTerrainLetterHasMovingAisPassability) {
+  const auto file = test::writeFile(dir_ / "m.map", "type octile\nheight 1\nwidth 7\nmap\n.GS@OTW\n");
+  EXPECT_EQ(drawn(loadMovingAiMap(file, 1.0)), (std::vector<std::string>{"...####"}));
+}
+
+TEST_F(MovingAiMap, UnknownTerrainLetterIsAnErrorNotAnObstacle) {
+  const std::string msg = error(replaced(kMovingAi, ".TSW", ".T?W"));
+  EXPECT_NE(msg.find(name() + ":6: column 2: terrain '?' is not one of"), std::string::npos) << msg;
+  const std::string tab = error(replaced(kMovingAi, "G..@", "G.\t@"));
+  EXPECT_NE(tab.find(name() + ":7: column 2: terrain '?'"), std::string::npos) << tab;
+}
+
 TEST_F(MovingAiMap, RowOfWrongLengthIsRejected) {
-  const std::string msg = error(replaced(kMovingAi, ".TS?", ".TS"));
+  const std::string msg = error(replaced(kMovingAi, ".TSW", ".TS"));
   EXPECT_NE(msg.find(name() + ":6:"), std::string::npos) << msg;
   EXPECT_NE(msg.find("row 1 '.TS' has 3 characters, expected 4"), std::string::npos) << msg;
 }

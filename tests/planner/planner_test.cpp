@@ -79,6 +79,7 @@ TEST(Planner, EachPlannerReturnsAClearPathFromStartToGoalAndTheClassItIsIn) {
   rrt_star.samples = 800;
   TopoPlannerConfig topo_config = perception.topo;
   topo_config.robot_radius_m = perception.robot_radius_m;
+  topo_config.path_margin_m = w.voxels.segmentCheckMargin();
   const TopologicalPlanner labeller(
       w.voxels.slice(kFlightZ - perception.slice_half_height_m, kFlightZ + perception.slice_half_height_m),
       topo_config);

@@ -230,6 +230,7 @@ TEST(PerceptionRrtStar, ChosenClassIsTheSliceClassOfThePath) {
   config.samples = 600;
   TopoPlannerConfig topo_config = config.topo;
   topo_config.robot_radius_m = config.robot_radius_m;
+  topo_config.path_margin_m = w.voxels.segmentCheckMargin();
   const TopologicalPlanner labeller(
       w.voxels.slice(kFlightZ - config.slice_half_height_m, kFlightZ + config.slice_half_height_m), topo_config);
   const TopoPlan slice = labeller.solve(w.start.p_WB.head<2>(), w.goal.p_WB.head<2>());
