@@ -134,8 +134,8 @@ double DistanceField::segmentClearance(const Eigen::Vector2d& a, const Eigen::Ve
 bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance_m) const {
   // Marching from a to b: clearance is 1-Lipschitz, so at a point whose clearance is at least
   // clearance_m + d the next d metres are clear and can be skipped (sphere tracing); where the
-  // margin is less than a quarter cell, the next quarter cell is measured exactly against the
-  // squares near it.
+  // margin is less than four cells, the next four cells are measured exactly against the squares
+  // near them (cheaper than many short steps along a wall).
   const double len = (b - a).norm();
   if (len == 0.0) return clearance(a) >= clearance_m;
   const Eigen::Vector2d dir = (b - a) / len;
@@ -144,6 +144,7 @@ bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d
   // A point is at most 0.71 cells from its cell's centre and an obstacle cell's square reaches
   // 0.71 cells from its own: the centre distance less 1.42 cells bounds the clearance from below.
   const double slack = 1.4143 * res;
+  const double exact_stretch = 4.0 * res;
   double t = 0.0;
   while (true) {
     const Eigen::Vector2d p = a + t * dir;
@@ -151,10 +152,10 @@ bool DistanceField::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d
     double margin = grid_.inside(c.x(), c.y()) ? centreDistance(c.x(), c.y()) - slack - clearance_m : -1.0;
     if (margin < min_step) margin = clearance(p) - clearance_m;
     if (margin < 0.0) return false;
-    if (margin < min_step) {
-      const double to = std::min(len, t + min_step);
+    if (margin < exact_stretch) {
+      const double to = std::min(len, t + exact_stretch);
       if (segmentClearance(p, a + to * dir, clearance_m) < clearance_m) return false;
-      margin = min_step;
+      margin = to - t;
     }
     if (t + margin >= len) return true;
     t += margin;

@@ -468,9 +468,10 @@ std::vector<Eigen::Vector2d> TopologicalPlanner::relax(std::vector<Eigen::Vector
           return field_.segmentClear(a, m, r) && field_.segmentClear(m, c, r) && !obstacleInTriangle(a, b, m) &&
                  !obstacleInTriangle(b, c, m);
         };
-        double lo = 0.0;
+        // All the way when it can (most moves in open space), else the farthest by bisection.
+        double lo = movable(1.0) ? 1.0 : 0.0;
         double hi = 1.0;
-        for (int it = 0; it < 10; ++it) {
+        for (int it = 0; it < 8 && lo < 1.0; ++it) {
           const double mid = 0.5 * (lo + hi);
           (movable(mid) ? lo : hi) = mid;
         }
@@ -680,8 +681,12 @@ TopoPlan TopologicalPlanner::solve(const Eigen::Vector2d& start, const Eigen::Ve
 
   // Winding of every edge around every obstacle point, in the a -> b direction.
   const std::size_t k_obs = obstacle_points_.size();
-  std::vector<std::vector<double>> edge_winding(g.edges.size(), std::vector<double>(k_obs, 0.0));
-  for (std::size_t e = 0; e < g.edges.size(); ++e) edge_winding[e] = hSignature(g.edges[e].points_m);
+  // Computed when a complete path first uses the edge: most edges are only ever expanded.
+  std::vector<std::vector<double>> edge_winding(g.edges.size());
+  auto windingOf = [&](int e) -> const std::vector<double>& {
+    if (edge_winding[e].size() != k_obs) edge_winding[e] = hSignature(g.edges[e].points_m);
+    return edge_winding[e];
+  };
 
   // Best-first search over simple paths, shortest first: A* on the exact distance to the goal
   // along the graph, so that complete paths come out in order of length while partial paths that
@@ -718,7 +723,8 @@ TopoPlan TopologicalPlanner::solve(const Eigen::Vector2d& start, const Eigen::Ve
         const TopoEdge& e = g.edges[edges[i]];
         const bool forward = e.a == froms[i];
         const double sign = forward ? 1.0 : -1.0;
-        for (std::size_t k = 0; k < k_obs; ++k) sig[k] += sign * edge_winding[edges[i]][k];
+        const std::vector<double>& w = windingOf(edges[i]);
+        for (std::size_t k = 0; k < k_obs; ++k) sig[k] += sign * w[k];
         std::vector<Eigen::Vector2d> seg = e.points_m;
         if (!forward) std::reverse(seg.begin(), seg.end());
         pts.insert(pts.end(), seg.begin() + (pts.empty() ? 0 : 1), seg.end());
