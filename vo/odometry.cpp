@@ -1,6 +1,7 @@
 #include "vo/odometry.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -19,6 +20,20 @@ namespace tgnav::vo {
 namespace {
 
 double rotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
+
+// Seconds since construction or the previous lap.
+class Stopwatch {
+ public:
+  double lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
 
 // Keypoints bucketed on a coarse grid, for window searches around a predicted pixel.
 class KeypointGrid {
@@ -173,18 +188,26 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     result.reason = msg.str();
     return record(result);
   }
+  Stopwatch clock;
   const Frame frame = prepareFrame(image, depth_m);
+  result.timing.features_s = clock.lap();
   result.features = static_cast<int>(frame.features.keypoints.size());
   result.with_depth = frame.with_depth;
-  if (!initialised_) return record(initialise(result, frame));
+  if (!initialised_) {
+    FrameResult first = initialise(result, frame);
+    first.timing.map_s = clock.lap();
+    return record(first);
+  }
 
   const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
   const LocalMapMatches matches = matchLocalMap(frame, X_CW_pred);
+  result.timing.matching_s = clock.lap();
   result.matches = static_cast<int>(matches.object.size());
   if (result.matches < config_.min_inliers) {
     return lose(result, std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
   }
   const PoseEstimate pose = estimatePose(matches, X_CW_pred);
+  result.timing.pnp_s = clock.lap();
   if (!pose.ransac_ok) {
     result.inliers = pose.ransac_inliers;
     return lose(result, std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
@@ -200,7 +223,11 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
   velocity_ = X_WC_.inverse() * X_WC;
   X_WC_ = X_WC;
   result.keyframe = updateLocalMap(frame, matches, pose);
-  if (result.keyframe && config_.ba.enabled) adjustLocalMap(&result);
+  result.timing.map_s = clock.lap();
+  if (result.keyframe && config_.ba.enabled) {
+    adjustLocalMap(&result);
+    result.timing.ba_s = clock.lap();
+  }
   result.X_WC = X_WC_;
   return record(result);
 }

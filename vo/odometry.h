@@ -103,6 +103,17 @@ struct FrameResult {
   double ba_correction_rad = std::numeric_limits<double>::quiet_NaN();
   int ba_outliers = 0;
   std::string reason;  // for lost frames: why (e.g. "12 inliers < 30")
+  // Wall-clock seconds of track()'s stages (not deterministic; never written to results that
+  // must repeat): ORB and back-projection, local-map matching, PnP (RANSAC and refinement),
+  // local-map upkeep (keyframe, landmarks), bundle adjustment.
+  struct Timing {
+    double features_s = 0.0;
+    double matching_s = 0.0;
+    double pnp_s = 0.0;
+    double map_s = 0.0;
+    double ba_s = 0.0;
+    double total() const { return features_s + matching_s + pnp_s + map_s + ba_s; }
+  } timing;
 };
 
 class RgbdOdometry {

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <memory>
+#include <opencv2/core/utility.hpp>
 #include <set>
 #include <sstream>
 
@@ -76,6 +78,8 @@ std::set<long> stripFrames(int count, double end_s, double camera_rate_hz) {
 // The flight of a trial with everything that runs beside the controller: the onboard camera and
 // the VO pipeline, the IMU and the estimator (state source vo), contact and bounds checks, progress.
 class ClosedLoop {
+  using Clock = std::chrono::steady_clock;
+
  public:
   ClosedLoop(const Scenario& scenario, const TrialOptions& options, const control::SetpointTrajectory& trajectory,
              TrialResult* result)
@@ -115,11 +119,21 @@ class ClosedLoop {
     FlightHooks hooks;
     if (fly_on_vo_) hooks.control_state = [this](const FlightLoop&) { return estimator_.state(); };
     hooks.after_step = [this](const FlightLoop& l) { return afterStep(l); };
-    wall0_ = std::chrono::steady_clock::now();
+    wall0_ = Clock::now();
+    tick_mark_ = wall0_;
+    ticks_.emplace_back();  // frame 0, rendered before the clock started
+    ticks_.back().rendered = true;
     result_->flight = flyTrajectory(loop_, trajectory_, cfg_.flight, hooks);
-    collectFrames(pipeline_->finish());
-    result_->flight_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+    // The physics after the last tick counts with it, and so does waiting for the VO to finish.
+    const Clock::time_point flown = Clock::now();
+    ticks_.back().sim_busy_s += seconds(flown - tick_mark_);
+    std::vector<VoPipeline::Done> done = pipeline_->finish();
+    const Clock::time_point end = Clock::now();
+    ticks_.back().sim_wait_s += seconds(end - flown);
+    result_->flight_wall_s = seconds(end - wall0_);
     result_->sim_time_s = data_->time;
+    collectFrames(std::move(done));
+    fillProfile();
     result_->vo_fused = estimator_.fused();
     result_->vo_rejected = estimator_.rejected();
     return events();
@@ -183,9 +197,40 @@ class ClosedLoop {
   void cameraTick(const FlightLoop& l) {
     ++frame_index_;
     const bool stop_rendering = fly_on_vo_ ? vo_failed_known_ : (!reinitialise_ && pipeline_->failedForGood());
-    if (!stop_rendering) pipeline_->submit(render(), strip_.count(frame_index_) > 0);
-    if (fly_on_vo_ && fused_up_to_ < frame_index_ - 1 && !vo_failed_known_) fuseResult(frame_index_ - 1);
+    TickProfile tick;
+    double blocked_s = 0.0;  // waiting for the VO stage
+    if (!stop_rendering) {
+      blocked_s += pipeline_->submit(render(), strip_.count(frame_index_) > 0);
+      tick.rendered = true;
+    }
+    if (fly_on_vo_ && fused_up_to_ < frame_index_ - 1 && !vo_failed_known_) {
+      const Clock::time_point t = Clock::now();
+      fuseResult(frame_index_ - 1);
+      blocked_s += seconds(Clock::now() - t);
+    }
     if (progress_) reportProgress(l);
+    const Clock::time_point now = Clock::now();
+    tick.sim_busy_s = seconds(now - tick_mark_) - blocked_s;
+    tick.sim_wait_s = blocked_s;
+    tick_mark_ = now;
+    ticks_.push_back(tick);
+  }
+
+  static double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+  void fillProfile() {
+    TrialProfile& p = result_->profile;
+    p.pipelined = cfg_.pipeline;
+    p.queue_capacity = static_cast<int>(VoPipeline::kQueueCapacity);
+    p.waits_for_pose = fly_on_vo_;
+    const char* lp = std::getenv("LP_NUM_THREADS");
+    p.llvmpipe_threads = lp != nullptr ? std::atoi(lp) : 0;
+    p.opencv_threads = cv::getNumThreads();
+    p.flight_wall_s = result_->flight_wall_s;
+    p.sim_time_s = result_->sim_time_s;
+    p.physics_s = loop_.physicsWallSeconds();
+    p.control_s = loop_.controlWallSeconds();
+    p.ticks = std::move(ticks_);
   }
 
   void fuseResult(long k) {
@@ -205,12 +250,19 @@ class ClosedLoop {
     const double on_traj = l.time() - timeline_.trajectory_start_s;
     const double traj_s = trajectory_.endTime() - trajectory_.startTime();
     pr.path_fraction = traj_s > 0 ? std::clamp(on_traj / traj_s, 0.0, 1.0) : 1.0;
-    pr.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+    pr.wall_s = seconds(Clock::now() - wall0_);
     progress_(pr);
   }
 
   // Frames up to the first loss (all of them when the VO re-initialises).
   void collectFrames(std::vector<VoPipeline::Done> done) {
+    for (std::size_t k = 0; k < done.size() && k < ticks_.size(); ++k) {
+      TickProfile& tick = ticks_[k];
+      tick.frame = done[k].frame_timing;
+      tick.vo = done[k].vo.timing;
+      // Sequential: the simulation thread tracked the frame itself; that counts as the VO's.
+      if (!cfg_.pipeline) tick.sim_busy_s = std::max(0.0, tick.sim_busy_s - tick.voBusy());
+    }
     for (VoPipeline::Done& d : done) {
       const bool lost = d.vo.status == vo::TrackingStatus::kLost;
       if (!d.image.empty()) {
@@ -269,7 +321,9 @@ class ClosedLoop {
   std::unique_ptr<VoPipeline> pipeline_;
   ProgressFn progress_;
   const std::atomic<bool>* interrupt_ = nullptr;
-  std::chrono::steady_clock::time_point wall0_;
+  Clock::time_point wall0_;
+  Clock::time_point tick_mark_;  // end of the last camera tick
+  std::vector<TickProfile> ticks_;
   long frame_index_ = 0;
   long fused_up_to_ = -1;
   bool vo_failed_known_ = false;

@@ -22,6 +22,7 @@
 #include "harness/config/scenario.h"
 #include "harness/run/frame_prediction.h"
 #include "harness/run/plan_run.h"
+#include "harness/run/trial_profile.h"
 #include "harness/run/trial_status.h"
 #include "harness/sim/flight_loop.h"
 #include "planner/feature_map.h"
@@ -69,6 +70,7 @@ struct TrialResult {
   double planned_flight_s = 0.0;
   int vo_fused = 0;            // VO poses the estimator took (state source vo)
   int vo_rejected = 0;         // ... and rejected by its gate
+  TrialProfile profile;        // where the flight's wall time went (trial_profile.h)
   std::vector<cv::Mat> strip;  // frames for the frame strip (TrialOptions::strip_frames)
   std::vector<std::string> strip_captions;
 };

@@ -140,7 +140,8 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
                  {"flight_wall_s", timing.flight_wall_s},
                  {"wall_time_s", timing.wall_time_s},
                  {"real_time_factor", rtf},
-                 {"peak_rss_mb", timing.peak_rss_mb}};
+                 {"peak_rss_mb", timing.peak_rss_mb},
+                 {"profile", result.profile.toJson()}};
   return j;
 }
 

@@ -1,9 +1,12 @@
 #pragma once
-// The VO stage of a trial: camera noise, then tracking, frame after frame in submission order;
-// on a worker thread (threaded: the simulation renders the next frames meanwhile) or inline. A
-// frame's noise and result do not depend on the mode, so a pipelined trial equals a sequential one.
+// The VO stage of a trial: camera noise, then tracking, frame after frame in submission order.
+// The noise is added on the submitting thread (the simulation's, which has time to spare while
+// the VO tracks), the tracking on a worker thread (threaded: the simulation renders the next
+// frames meanwhile) or inline. A frame's noise and result do not depend on the mode, so a
+// pipelined trial equals a sequential one.
 #include <Eigen/Geometry>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -22,7 +25,8 @@ class VoPipeline {
   struct Done {
     vo::FrameResult vo;
     Eigen::Isometry3d X_WC_true;
-    cv::Mat image;  // the noised image, when asked to keep it (and at the first loss)
+    cv::Mat image;                   // the noised image, when asked to keep it (and at the first loss)
+    RgbdFrame::Timing frame_timing;  // rendering and noise (wall clock; vo.timing has tracking's)
   };
 
   VoPipeline(vo::RgbdOdometry& odometry, CameraNoise& noise, bool reinitialises, bool threaded)
@@ -33,17 +37,23 @@ class VoPipeline {
   VoPipeline(const VoPipeline&) = delete;
   VoPipeline& operator=(const VoPipeline&) = delete;
 
-  void submit(RgbdFrame frame, bool keep_image) {
+  // Adds the noise, then tracks the frame (inline) or queues it (threaded). Returns the seconds
+  // it waited for room in the queue.
+  double submit(RgbdFrame frame, bool keep_image) {
+    noise_.apply(&frame);
     if (!worker_.joinable()) {
       process(Job{std::move(frame), keep_image});
-      return;
+      return 0.0;
     }
+    const auto t0 = std::chrono::steady_clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
     // A short queue bounds memory; the simulation runs at most this far ahead of the VO.
     changed_.wait(lock, [&] { return queue_.size() < kQueueCapacity || error_; });
+    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     rethrowLocked();
     queue_.push_back(Job{std::move(frame), keep_image});
     changed_.notify_all();
+    return waited;
   }
 
   // The result of the k-th submitted frame, waiting for it.
@@ -53,6 +63,9 @@ class VoPipeline {
     rethrowLocked();
     return done_[k];
   }
+
+  // Frames the simulation may submit before the VO has started on them.
+  static constexpr std::size_t kQueueCapacity = 3;
 
   // Whether some frame processed so far was lost for good (no re-initialisation).
   bool failedForGood() const { return failed_for_good_.load(); }
@@ -65,16 +78,15 @@ class VoPipeline {
   }
 
  private:
-  static constexpr std::size_t kQueueCapacity = 3;
   struct Job {
     RgbdFrame frame;
     bool keep_image;
   };
 
   void process(Job job) {
-    noise_.apply(&job.frame);
     const bool failed_before = odometry_.failed();
-    Done d{odometry_.track(job.frame.t_s, job.frame.bgr, job.frame.depth_m), job.frame.X_WC, cv::Mat()};
+    Done d{odometry_.track(job.frame.t_s, job.frame.bgr, job.frame.depth_m), job.frame.X_WC, cv::Mat(),
+           job.frame.timing};
     const bool first_loss = !failed_before && odometry_.failed();
     if (job.keep_image || first_loss) d.image = job.frame.bgr;
     if (odometry_.failed() && !reinitialises_) failed_for_good_.store(true);

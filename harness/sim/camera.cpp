@@ -1,5 +1,6 @@
 #include "harness/sim/camera.h"
 
+#include <chrono>
 #include <cmath>
 #include <opencv2/core.hpp>
 #include <stdexcept>
@@ -32,6 +33,7 @@ Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std
 
   m->vis.global.offwidth = std::max(m->vis.global.offwidth, config_.width_px);
   m->vis.global.offheight = std::max(m->vis.global.offheight, config_.height_px);
+  m->vis.quality.offsamples = config_.offscreen_samples;
   m->vis.map.znear = static_cast<float>(config_.near_clip_m / m->stat.extent);
   m->vis.map.zfar = static_cast<float>(config_.far_clip_m / m->stat.extent);
   // What OpenGL will actually use (float precision of vis.map included).
@@ -98,6 +100,8 @@ RgbdFrame Camera::render(mjData* d) {
 }
 
 RgbdFrame Camera::renderNoiseless(mjData* d) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t0 = Clock::now();
   gl_.makeCurrent();
   const int w = config_.width_px;
   const int h = config_.height_px;
@@ -106,7 +110,9 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, w, h};
   mjr_render(viewport, &scene_, &context_);
+  const Clock::time_point t1 = Clock::now();
   mjr_readPixels(rgb_buffer_.data(), depth_buffer_.data(), viewport, &context_);
+  const Clock::time_point t2 = Clock::now();
 
   RgbdFrame frame;
   frame.t_s = d->time;
@@ -127,6 +133,10 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
       depth[col] = (z >= min_depth && z <= max_depth) ? z : 0.0f;
     }
   }
+  const Clock::time_point t3 = Clock::now();
+  frame.timing.render_s = std::chrono::duration<double>(t1 - t0).count();
+  frame.timing.readback_s = std::chrono::duration<double>(t2 - t1).count();
+  frame.timing.convert_s = std::chrono::duration<double>(t3 - t2).count();
   return frame;
 }
 
@@ -141,6 +151,7 @@ CameraNoise::CameraNoise(const CameraConfig& config, std::uint64_t seed)
 }
 
 void CameraNoise::apply(RgbdFrame* frame) {
+  const auto t0 = std::chrono::steady_clock::now();
   if (rgb_sigma_ > 0.0) {
     noise_.create(frame->bgr.size(), CV_32FC3);
     rng_.fill(noise_, cv::RNG::NORMAL, 0.0, rgb_sigma_);
@@ -165,6 +176,7 @@ void CameraNoise::apply(RgbdFrame* frame) {
       }
     }
   }
+  frame->timing.noise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 }  // namespace tgnav::harness

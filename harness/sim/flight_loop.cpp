@@ -50,6 +50,8 @@ bool FlightLoop::step(const control::TrajectorySetpoint& setpoint) { return step
 
 bool FlightLoop::step(const control::TrajectorySetpoint& setpoint, const control::VehicleState& s) {
   if (!divergence_.empty()) return false;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t0 = Clock::now();
   const double dt = m_->opt.timestep;
   if (steps_ % per_position_ == 0) cascade_.updatePosition(s, setpoint, per_position_ * dt);
   if (steps_ % per_attitude_ == 0) cascade_.updateAttitude(s.q_WB);
@@ -61,7 +63,10 @@ bool FlightLoop::step(const control::TrajectorySetpoint& setpoint, const control
     }
     for (int i = 0; i < 4; ++i) d_->ctrl[ids_.motors[i]] = thrust_n[i];
   }
+  const Clock::time_point t1 = Clock::now();
   mj_step(m_, d_);
+  physics_wall_s_ += std::chrono::duration<double>(Clock::now() - t1).count();
+  control_wall_s_ += std::chrono::duration<double>(t1 - t0).count();
   ++steps_;
   return !checkDiverged();
 }

@@ -5,6 +5,7 @@
 // the caller hands it an estimate (FlightHooks::control_state).
 #include <mujoco/mujoco.h>
 
+#include <chrono>
 #include <functional>
 #include <string>
 #include <vector>
@@ -36,6 +37,9 @@ class FlightLoop {
   control::VehicleState state() const { return vehicleState(d_, ids_); }
   double time() const { return d_->time; }
   long steps() const { return steps_; }  // physics steps taken by this loop
+  // Wall-clock seconds spent so far in the controller stages and in mj_step (not deterministic).
+  double controlWallSeconds() const { return control_wall_s_; }
+  double physicsWallSeconds() const { return physics_wall_s_; }
   bool positionUpdateDue() const { return steps_ % per_position_ == 0; }
   const std::string& divergence() const { return divergence_; }
   const control::VehicleParams& vehicle() const { return vehicle_; }
@@ -54,6 +58,8 @@ class FlightLoop {
   int per_attitude_ = 2;
   int per_position_ = 5;
   long steps_ = 0;
+  double control_wall_s_ = 0.0;
+  double physics_wall_s_ = 0.0;
   double max_tilt_rad_ = M_PI / 2;
   double max_speed_m_s_ = 20.0;
   std::string divergence_;

@@ -66,6 +66,17 @@ void expectTrialFolder(const std::filesystem::path& dir) {
     EXPECT_TRUE(m["timing"].contains(key)) << key;
     EXPECT_EQ(m["timing"][key], m[key]) << key;
   }
+  // The per-stage profile: every tracked frame in it, per-thread totals, the critical path.
+  ASSERT_TRUE(m["timing"].contains("profile"));
+  const nlohmann::json& profile = m["timing"]["profile"];
+  EXPECT_EQ(profile["frames_tracked"], m["vo_frames"]);
+  for (const char* stage :
+       {"render", "readback", "convert", "noise", "vo_features", "vo_matching", "vo_pnp", "vo_ba"}) {
+    EXPECT_GE(profile["per_frame_ms"][stage].get<double>(), 0.0) << stage;
+  }
+  EXPECT_GT(profile["per_frame_ms"]["vo_features"].get<double>(), 0.0);
+  EXPECT_GT(profile["threads"]["simulation"]["busy_s"].get<double>(), 0.0);
+  EXPECT_GT(profile["critical_path"]["total_s"].get<double>(), 0.0);
   // Trajectories read back as TUM files; images decode.
   const auto gt = vo::parseTum(readText(dir / "gt.tum"));
   const auto est = vo::parseTum(readText(dir / "est.tum"));

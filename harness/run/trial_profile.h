@@ -1,0 +1,46 @@
+#pragma once
+// Where a trial's flight spends its wall-clock time: per camera tick, what the simulation thread
+// did (physics, control, rendering) and waited for, and what the VO stage did with the frame;
+// summed per stage and per thread, with the critical path. Wall-clock figures only: none of it is
+// deterministic, and none of it feeds a result that must repeat (metrics.json `timing.profile`).
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "harness/sim/camera.h"
+#include "vo/odometry.h"
+
+namespace tgnav::harness {
+
+// One camera tick. Frame 0 is rendered before the flight's clock starts; tick k >= 1 covers the
+// simulation thread from the end of tick k-1 to the end of tick k.
+struct TickProfile {
+  double sim_busy_s = 0.0;  // the simulation thread working (physics, control, IMU, checks, render, noise)
+  double sim_wait_s = 0.0;  // ... blocked on the VO stage (full queue, or the pose it flies on)
+  bool rendered = false;    // a frame was rendered and tracked at this tick
+  RgbdFrame::Timing frame;  // render, readback, convert, noise (simulation thread)
+  vo::FrameResult::Timing vo;
+  double voBusy() const { return vo.total(); }
+};
+
+struct TrialProfile {
+  bool pipelined = false;       // VO on its own thread (trial.pipeline)
+  int queue_capacity = 0;       // frames the simulation may run ahead of the VO (pipelined)
+  bool waits_for_pose = false;  // the controller flies on the VO: tick k waits for frame k-1's pose
+  int llvmpipe_threads = 0;     // LP_NUM_THREADS as the renderer saw it (0: unset, llvmpipe's default)
+  int opencv_threads = 0;       // cv::getNumThreads()
+  double flight_wall_s = 0.0;   // the flight's wall time, which the ticks add up to
+  double sim_time_s = 0.0;      // simulated seconds flown
+  double physics_s = 0.0;       // mj_step
+  double control_s = 0.0;       // the cascade's stages
+  std::vector<TickProfile> ticks;
+
+  // The critical path through the ticks: the flight's wall time as the measured work of each
+  // tick and stage implies it. Sequential, the sum of both stages. Pipelined, a replay of the
+  // pipeline: tick k's frame enters the queue once the simulation has done tick k's work and the
+  // queue has room (frame k - capacity has started tracking), the VO tracks frames in order as
+  // they arrive, and flying on the VO, tick k also waits for frame k-1's pose.
+  double criticalPathSeconds() const;
+  nlohmann::ordered_json toJson() const;
+};
+
+}  // namespace tgnav::harness

@@ -1,0 +1,104 @@
+// TrialProfile's critical path (a replay of the render/VO pipeline from measured stage times) on
+// hand-made ticks whose answer is known, and what metrics.json's `timing.profile` holds.
+#include "harness/run/trial_profile.h"
+
+#include <gtest/gtest.h>
+
+namespace tgnav::harness {
+namespace {
+
+TickProfile tick(double sim_s, double vo_s, bool rendered = true) {
+  TickProfile t;
+  t.sim_busy_s = sim_s;
+  t.rendered = rendered;
+  t.vo.features_s = vo_s;
+  return t;
+}
+
+TrialProfile profile(bool pipelined, int ticks, double sim_s, double vo_s) {
+  TrialProfile p;
+  p.pipelined = pipelined;
+  p.queue_capacity = 3;
+  for (int k = 0; k < ticks; ++k) p.ticks.push_back(tick(k == 0 ? 0.0 : sim_s, vo_s));
+  return p;
+}
+
+TEST(TrialProfile, SequentialIsTheSumOfBothStages) {
+  EXPECT_NEAR(profile(false, 10, 0.01, 0.02).criticalPathSeconds(), 9 * 0.01 + 10 * 0.02, 1e-12);
+}
+
+// Pipelined, the slower stage sets the pace: n frames of VO after the first tick's, or the
+// simulation's ticks and the last frame's VO.
+TEST(TrialProfile, PipelinedRunsAtTheSlowerStage) {
+  EXPECT_NEAR(profile(true, 100, 0.01, 0.02).criticalPathSeconds(), 100 * 0.02, 1e-12);
+  EXPECT_NEAR(profile(true, 100, 0.02, 0.01).criticalPathSeconds(), 99 * 0.02 + 0.01, 1e-12);
+}
+
+// One slow VO frame is absorbed by the queue when the simulation has slack; with a queue of one
+// frame the simulation must wait for it.
+TEST(TrialProfile, TheQueueAbsorbsASlowFrame) {
+  TrialProfile p = profile(true, 20, 0.02, 0.01);
+  p.ticks[5].vo.ba_s = 0.04;  // frame 5 (submitted at 100 ms) tracks in 50 ms
+  const double unhurried = 19 * 0.02 + 0.01;
+  EXPECT_NEAR(p.criticalPathSeconds(), unhurried, 1e-12);
+  // Capacity 1: frame 7 (ready at 140 ms) enters the queue only once frame 6 has started, when
+  // frame 5 is done at 150 ms: the ticks slip by 10 ms.
+  p.queue_capacity = 1;
+  EXPECT_NEAR(p.criticalPathSeconds(), unhurried + 0.01, 1e-12);
+}
+
+// Flying on the VO, tick k waits for frame k-1's pose: a slow frame the queue would absorb
+// holds the simulation up instead. Frame 5 tracks in 30 ms and ends at 80 ms; tick 6 (done at
+// 60 ms) waits for it, and every later tick slips by those 20 ms.
+TEST(TrialProfile, WaitingForThePoseSerialisesTheStages) {
+  TrialProfile p = profile(true, 50, 0.01, 0.005);
+  p.ticks[5].vo.ba_s = 0.025;
+  EXPECT_NEAR(p.criticalPathSeconds(), 49 * 0.01 + 0.005, 1e-12);
+  p.waits_for_pose = true;
+  EXPECT_NEAR(p.criticalPathSeconds(), 49 * 0.01 + 0.005 + 0.02, 1e-12);
+}
+
+// Ticks without a frame (tracking lost for good) cost the simulation only.
+TEST(TrialProfile, TicksWithoutAFrameCostTheSimulationOnly) {
+  TrialProfile p = profile(true, 10, 0.01, 0.005);
+  for (int k = 0; k < 5; ++k) p.ticks.push_back(tick(0.01, 0.0, false));
+  EXPECT_NEAR(p.criticalPathSeconds(), 14 * 0.01, 1e-12);
+}
+
+TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
+  TrialProfile p = profile(true, 4, 0.02, 0.01);
+  p.flight_wall_s = 0.07;
+  p.sim_time_s = 0.2;
+  p.physics_s = 0.004;
+  p.control_s = 0.001;
+  for (TickProfile& t : p.ticks) {
+    t.frame.render_s = 0.002;
+    t.frame.readback_s = 0.006;
+    t.frame.noise_s = 0.001;
+    t.sim_wait_s = 0.0005;
+  }
+  const nlohmann::ordered_json j = p.toJson();
+  EXPECT_EQ(j["camera_ticks"], 4);
+  EXPECT_EQ(j["frames_tracked"], 4);
+  EXPECT_NEAR(j["per_frame_ms"]["readback"].get<double>(), 6.0, 1e-9);
+  EXPECT_NEAR(j["per_frame_ms"]["vo_total"].get<double>(), 10.0, 1e-9);
+  EXPECT_NEAR(j["per_sim_second_ms"]["physics"].get<double>(), 20.0, 1e-9);
+  const auto& sim = j["threads"]["simulation"];
+  EXPECT_NEAR(sim["busy_s"].get<double>(), 0.06, 1e-12);
+  EXPECT_NEAR(sim["wait_vo_s"].get<double>(), 0.002, 1e-12);
+  EXPECT_NEAR(sim["render_s"].get<double>(), 4 * 0.008, 1e-12);
+  EXPECT_NEAR(sim["other_s"].get<double>(), 0.06 - 0.004 - 0.001 - 4 * 0.009, 1e-12);
+  EXPECT_NEAR(j["threads"]["vo"]["busy_s"].get<double>(), 0.04, 1e-12);
+  EXPECT_NEAR(j["threads"]["vo"]["idle_s"].get<double>(), 0.03, 1e-12);
+  EXPECT_EQ(j["bottleneck"], "simulation");
+  EXPECT_NEAR(j["critical_path"]["total_s"].get<double>(), 3 * 0.02 + 0.01, 1e-12);
+  EXPECT_NEAR(j["critical_path"]["ratio_to_wall"].get<double>(), 1.0, 1e-9);
+  // Sequential: the tracking is listed as the VO stage's, on the simulation thread.
+  p.pipelined = false;
+  const nlohmann::ordered_json s = p.toJson();
+  EXPECT_TRUE(s["threads"].contains("vo_on_simulation_thread"));
+  EXPECT_EQ(s["bottleneck"], "sequential");
+}
+
+}  // namespace
+}  // namespace tgnav::harness
