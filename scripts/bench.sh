@@ -54,6 +54,11 @@ for size in 640x480 320x240; do
     --planner proposed --seed 1 --set camera.width_px="${size%x*}" --set camera.height_px="${size#*x}" \
     --out "$out/trials/storage-proposed-$size" >&2
 done
+# The same 640x480 trial without multisampling (camera.offscreen_samples=0) and with one llvmpipe
+# thread, leaving the VO thread a core: the candidate defaults of the faster loop.
+LP_NUM_THREADS=1 "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" \
+  --map "$out/maps/storage" --planner proposed --seed 1 --set camera.offscreen_samples=0 \
+  --out "$out/trials/storage-proposed-640x480-msaa0-lp1" >&2
 
 # Sweep throughput: the smoke sweep (6 trials, each single-threaded) one and two at a time.
 for jobs in 1 2; do
@@ -91,6 +96,22 @@ for run in sorted(os.listdir(trials)) if os.path.isdir(trials) else []:
     m = json.load(open(os.path.join(trials, run, "metrics.json")))
     for figure in ("wall_time_s", "flight_wall_s", "real_time_factor", "peak_rss_mb"):
         rows.append({"benchmark": f"trial/{run}", "figure": figure, "value": m["timing"][figure]})
+    # The per-stage profile (metrics.json timing.profile): ms per camera frame of each stage,
+    # per-thread totals and the critical path against the flight's wall time.
+    profile = m["timing"].get("profile")
+    if profile:
+        for stage, ms in profile["per_frame_ms"].items():
+            rows.append({"benchmark": f"trial/{run}/frame", "figure": f"ms_{stage}", "value": ms})
+        for stage, ms in profile["per_sim_second_ms"].items():
+            rows.append({"benchmark": f"trial/{run}/sim_second", "figure": f"ms_{stage}", "value": ms})
+        for thread, totals in profile["threads"].items():
+            for figure in ("busy_s", "wait_vo_s", "idle_s"):
+                if figure in totals:
+                    rows.append({"benchmark": f"trial/{run}/{thread}", "figure": figure, "value": totals[figure]})
+        rows.append({"benchmark": f"trial/{run}/critical_path", "figure": "ms_per_tick",
+                     "value": profile["critical_path"]["ms_per_tick"]})
+        rows.append({"benchmark": f"trial/{run}/critical_path", "figure": "ratio_to_wall",
+                     "value": profile["critical_path"]["ratio_to_wall"]})
 per_min = {}
 for jobs in (1, 2):
     elapsed = os.path.join(out, f"sweep-jobs{jobs}", "elapsed")

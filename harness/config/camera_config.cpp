@@ -17,6 +17,8 @@ void CameraConfig::validate() const {
   require(max_depth_m > min_depth_m && max_depth_m <= far_clip_m, "max_depth_m", max_depth_m,
           "must be in (min_depth_m, far_clip_m]");
   require(rgb_noise_sigma >= 0.0, "rgb_noise_sigma", rgb_noise_sigma, "must be >= 0");
+  require(offscreen_samples == 0 || offscreen_samples == 2 || offscreen_samples == 4 || offscreen_samples == 8,
+          "offscreen_samples", offscreen_samples, "must be 0, 2, 4 or 8");
   require(depth_noise_sigma_per_m2 >= 0.0, "depth_noise_sigma_per_m2", depth_noise_sigma_per_m2, "must be >= 0");
 }
 

@@ -15,6 +15,10 @@ struct CameraConfig {
   double max_depth_m = 10.0;
   double rgb_noise_sigma = 0.0;           // Gaussian pixel noise, 8-bit intensity units
   double depth_noise_sigma_per_m2 = 0.0;  // depth noise sigma = k z^2 (structured light)
+  // Multisample anti-aliasing of the offscreen render (MuJoCo's <quality offsamples>, whose
+  // default is 4): 0 renders one sample per pixel, as a real camera's pixels integrate no
+  // sub-pixel geometry edges either. Overrides the model's setting.
+  int offscreen_samples = 4;
 
   // The keys of configs/camera.yaml (harness/config/yaml_util.h).
   template <typename Archive>
@@ -28,6 +32,7 @@ struct CameraConfig {
     a("max_depth_m", max_depth_m);
     a("rgb_noise_sigma", rgb_noise_sigma);
     a("depth_noise_sigma_per_m2", depth_noise_sigma_per_m2);
+    a("offscreen_samples", offscreen_samples);
   }
 
   // Throws std::invalid_argument naming the field and value.

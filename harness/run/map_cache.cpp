@@ -51,7 +51,7 @@ std::string settingsText(const SceneConfig& scene, const MapBuildConfig& c) {
     << c.max_hamming << ' ' << c.min_observations << ' ' << c.max_shift_m << ' ' << c.depth_edge_m << '\n'
     << c.camera.name << ' ' << c.camera.width_px << ' ' << c.camera.height_px << ' ' << c.camera.near_clip_m << ' '
     << c.camera.far_clip_m << ' ' << c.camera.min_depth_m << ' ' << c.camera.max_depth_m << ' '
-    << c.camera.rgb_noise_sigma << ' ' << c.camera.depth_noise_sigma_per_m2 << '\n'
+    << c.camera.rgb_noise_sigma << ' ' << c.camera.depth_noise_sigma_per_m2 << ' ' << c.camera.offscreen_samples << '\n'
     << c.features.max_features << ' ' << c.features.grid_cols << ' ' << c.features.grid_rows << ' '
     << c.features.fast_threshold << ' ' << c.features.scale_factor << ' ' << c.features.pyramid_levels << ' '
     << c.features.edge_threshold_px << '\n';

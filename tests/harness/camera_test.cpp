@@ -141,6 +141,29 @@ TEST_F(CameraTest, MarkerAppearsWhereTheIntrinsicsProjectIt) {
   EXPECT_NEAR(sv / n, v_expected, 1.0);
 }
 
+// camera.offscreen_samples: with multisampling the marker's silhouette blends red into the grey
+// wall; with one sample per pixel every pixel is either the marker's or the wall's.
+TEST_F(CameraTest, OffscreenSamplesBlendSilhouettesOnlyWhenMultisampled) {
+  auto blended = [&](int samples) {
+    EglContext gl;
+    CameraConfig config = config_;
+    config.offscreen_samples = samples;
+    Camera camera(model_.get(), gl, config, 0);
+    const RgbdFrame frame = camera.renderNoiseless(data_.get());
+    int n = 0;
+    for (int v = 0; v < frame.bgr.rows; ++v) {
+      for (int u = 0; u < frame.bgr.cols; ++u) {
+        const cv::Vec3b bgr = frame.bgr.at<cv::Vec3b>(v, u);
+        const int redness = static_cast<int>(bgr[2]) - static_cast<int>(bgr[1]);
+        if (redness > 40 && redness < 200) ++n;  // partly marker, partly wall
+      }
+    }
+    return n;
+  };
+  EXPECT_GT(blended(4), 5);
+  EXPECT_EQ(blended(0), 0);
+}
+
 TEST_F(CameraTest, NoiseIsSeededAndBounded) {
   config_.rgb_noise_sigma = 3.0;
   config_.depth_noise_sigma_per_m2 = 0.002;

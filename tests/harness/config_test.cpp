@@ -34,6 +34,7 @@ TEST(CameraConfigFile, ShippedFileEqualsBuiltInDefaults) {
   EXPECT_EQ(file.max_depth_m, defaults.max_depth_m);
   EXPECT_EQ(file.rgb_noise_sigma, defaults.rgb_noise_sigma);
   EXPECT_EQ(file.depth_noise_sigma_per_m2, defaults.depth_noise_sigma_per_m2);
+  EXPECT_EQ(file.offscreen_samples, defaults.offscreen_samples);
 }
 
 TEST(CameraConfigFile, UnknownKeyNamesFileLineAndKey) {
@@ -57,6 +58,12 @@ TEST(CameraConfigFile, ValidationFailureNamesFileKeyAndValue) {
   const std::string msg = inputError([&] { loadCameraConfig(file); });
   EXPECT_NE(msg.find(file.string()), std::string::npos) << msg;
   EXPECT_NE(msg.find("max_depth_m = -1"), std::string::npos) << msg;
+  // Multisampling: the counts OpenGL offers everywhere, or none.
+  const auto samples = test::writeFile(test::tempDir() / "cam3.yaml", "offscreen_samples: 3\n");
+  const std::string bad = inputError([&] { loadCameraConfig(samples); });
+  EXPECT_NE(bad.find("offscreen_samples = 3: must be 0, 2, 4 or 8"), std::string::npos) << bad;
+  const auto none = test::writeFile(test::tempDir() / "cam4.yaml", "offscreen_samples: 0\n");
+  EXPECT_EQ(loadCameraConfig(none).offscreen_samples, 0);
 }
 
 TEST(CameraConfigFile, SyntaxErrorNamesLine) {
