@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "harness/base/errors.h"
+#include "harness/base/ordered_worker.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
@@ -21,6 +22,8 @@ using Clock = std::chrono::steady_clock;
 // Rotor tips of models/quadrotor.xml: 0.25 m arm + 0.12 m propeller, rounded down: the start
 // and goal must leave at least this much room.
 constexpr double kVehicleRadiusM = 0.3;
+// Survey frames rendered ahead of their integration (bounds the memory of a fast renderer).
+constexpr std::size_t kSurveyQueueFrames = 4;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // A landmark being accumulated over observations.
@@ -222,20 +225,27 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   planner::FeatureMap map(config.resolution_m);
   LandmarkAssociator associator(config.merge_radius_m, config.max_hamming);
 
-  for (std::size_t f = 0; f < poses.size(); ++f) {
-    auto t0 = Clock::now();
-    setVehiclePose(model.get(), data.get(), ids, poses[f]);
-    const RgbdFrame frame = camera.render(data.get());
-    stats.render_s += since(t0);
-    t0 = Clock::now();
+  // This thread renders the survey; a worker integrates the frames in order (depth into the
+  // occupancy, keypoints into the landmark tracks) while the next ones render: the same map as one
+  // thread doing both in turn. The two touch different fields of `stats`.
+  OrderedWorker<RgbdFrame> integrator(kSurveyQueueFrames, [&](RgbdFrame& frame) {
+    Clock::time_point t0 = Clock::now();
     insertDepth(frame, k, config, &map.occupancy());
     stats.integrate_s += since(t0);
     t0 = Clock::now();
     observeFeatures(frame, k, config, detector, &associator, &stats);
     stats.features_s += since(t0);
+  });
+  for (std::size_t f = 0; f < poses.size(); ++f) {
+    const Clock::time_point t0 = Clock::now();
+    setVehiclePose(model.get(), data.get(), ids, poses[f]);
+    RgbdFrame frame = camera.render(data.get());
+    stats.render_s += since(t0);
+    integrator.submit(std::move(frame));
     ++stats.frames;
     if (progress) progress(static_cast<int>(f + 1), static_cast<int>(poses.size()));
   }
+  integrator.finish();
 
   map.setLandmarks(keptLandmarks(associator, config.min_observations, &stats));
   stats.landmarks_merged = static_cast<int>(associator.tracks().size());

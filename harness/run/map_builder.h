@@ -20,6 +20,8 @@ struct MapBuildStats {
   int dropped_few_observations = 0;
   int dropped_not_embedded = 0;
   int landmarks = 0;  // in the final map
+  // Wall-clock seconds: rendering the survey (this thread), integrating its depth and keypoints
+  // (a worker, overlapping the rendering), and the whole build.
   double render_s = 0.0;
   double integrate_s = 0.0;
   double features_s = 0.0;
