@@ -150,13 +150,6 @@ RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig&
 }
 
 // A frame's features and their 3D points in the camera frame.
-struct RgbdOdometry::Frame {
-  Features features;
-  std::vector<Eigen::Vector3d> p_C;  // per keypoint, where valid
-  std::vector<bool> valid;           // depth in range and not on a discontinuity
-  int with_depth = 0;                // valid ones
-};
-
 // The local map's landmarks matched to a frame's keypoints, and the 2D-3D correspondences.
 struct RgbdOdometry::LocalMapMatches {
   std::vector<int> landmark_of;     // keypoint -> landmark (-1: none)
@@ -174,8 +167,13 @@ struct RgbdOdometry::PoseEstimate {
   std::vector<bool> is_inlier;  // per correspondence
 };
 
-FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat& depth_m) {
-  checkFrame(t_s, image, depth_m);
+FrameResult RgbdOdometry::track(const Frame& frame) {
+  const double t_s = frame.t_s;
+  if (!std::isfinite(t_s) || t_s <= last_t_) {
+    std::ostringstream msg;
+    msg << "frame time " << t_s << " s does not come after the previous frame's (" << last_t_ << " s)";
+    throw std::invalid_argument(msg.str());
+  }
   last_t_ = t_s;
   ++frame_;
 
@@ -189,8 +187,7 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
     return record(result);
   }
   Stopwatch clock;
-  const Frame frame = prepareFrame(image, depth_m);
-  result.timing.features_s = clock.lap();
+  result.timing.features_s = frame.prepare_s;
   result.features = static_cast<int>(frame.features.keypoints.size());
   result.with_depth = frame.with_depth;
   if (!initialised_) {
@@ -232,12 +229,7 @@ FrameResult RgbdOdometry::track(double t_s, const cv::Mat& image, const cv::Mat&
   return record(result);
 }
 
-void RgbdOdometry::checkFrame(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const {
-  if (!std::isfinite(t_s) || t_s <= last_t_) {
-    std::ostringstream msg;
-    msg << "frame time " << t_s << " s does not come after the previous frame's (" << last_t_ << " s)";
-    throw std::invalid_argument(msg.str());
-  }
+void RgbdOdometry::checkImages(const cv::Mat& image, const cv::Mat& depth_m) const {
   if (image.empty() || (image.type() != CV_8UC1 && image.type() != CV_8UC3) || image.cols != camera_.width_px ||
       image.rows != camera_.height_px) {
     throw std::invalid_argument("image: expected 8-bit gray or BGR of " + std::to_string(camera_.width_px) + "x" +
@@ -249,8 +241,11 @@ void RgbdOdometry::checkFrame(double t_s, const cv::Mat& image, const cv::Mat& d
   }
 }
 
-RgbdOdometry::Frame RgbdOdometry::prepareFrame(const cv::Mat& image, const cv::Mat& depth_m) const {
-  Frame frame;
+RgbdOdometry::PreparedFrame RgbdOdometry::prepare(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const {
+  checkImages(image, depth_m);
+  Stopwatch clock;
+  PreparedFrame frame;
+  frame.t_s = t_s;
   frame.features = detector_.detect(toGray(image));
   const std::size_t n = frame.features.keypoints.size();
   frame.p_C.resize(n);
@@ -260,6 +255,7 @@ RgbdOdometry::Frame RgbdOdometry::prepareFrame(const cv::Mat& image, const cv::M
     frame.valid[i] = true;
     ++frame.with_depth;
   }
+  frame.prepare_s = clock.lap();
   return frame;
 }
 

@@ -122,10 +122,26 @@ class RgbdOdometry {
   RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig& config,
                const Eigen::Isometry3d& X_WC0 = Eigen::Isometry3d::Identity());
 
+  // A frame's keypoints with their descriptors and 3D points: all track() needs of the images.
+  // Preparing does not depend on the odometry's state, so one thread may prepare the next frames
+  // while another tracks (the results are the same).
+  struct PreparedFrame {
+    double t_s = 0.0;
+    Features features;
+    std::vector<Eigen::Vector3d> p_C;  // per keypoint, where valid
+    std::vector<bool> valid;           // depth in range and not on a discontinuity
+    int with_depth = 0;                // valid ones
+    double prepare_s = 0.0;            // wall-clock seconds it took (FrameResult::timing.features_s)
+  };
+
   // `image`: CV_8UC1 or CV_8UC3 (BGR); `depth_m`: CV_32FC1 metres along the optical axis, 0 or
-  // non-finite = invalid; both of the camera's size (std::invalid_argument otherwise). Frames
-  // must come in increasing time.
-  FrameResult track(double t_s, const cv::Mat& image, const cv::Mat& depth_m);
+  // non-finite = invalid; both of the camera's size (std::invalid_argument otherwise).
+  PreparedFrame prepare(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const;
+  // Frames must come in increasing time (std::invalid_argument otherwise).
+  FrameResult track(const PreparedFrame& frame);
+  FrameResult track(double t_s, const cv::Mat& image, const cv::Mat& depth_m) {
+    return track(prepare(t_s, image, depth_m));
+  }
 
   bool failed() const { return failed_; }         // lost at least once
   double failedAt() const { return failed_at_; }  // time of the first loss (NaN if none)
@@ -152,14 +168,13 @@ class RgbdOdometry {
     int tracked = 0;                        // landmarks it tracked or created
     std::vector<Observation> observations;  // landmarks it tracked or created, where it saw them
   };
-  struct Frame;            // features and their 3D points
+  using Frame = PreparedFrame;
   struct LocalMapMatches;  // landmarks matched to a frame's keypoints
   struct PoseEstimate;     // PnP RANSAC and its refinement
 
   // The steps of track, in order (initialise instead of the rest for a first frame, or the
   // first after a loss with reinitialise_after_lost).
-  void checkFrame(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const;
-  Frame prepareFrame(const cv::Mat& image, const cv::Mat& depth_m) const;
+  void checkImages(const cv::Mat& image, const cv::Mat& depth_m) const;
   FrameResult initialise(FrameResult result, const Frame& frame);
   Eigen::Isometry3d predictPose() const { return X_WC_ * velocity_; }  // constant-velocity motion model
   LocalMapMatches matchLocalMap(const Frame& frame, const Eigen::Isometry3d& X_CW_pred) const;

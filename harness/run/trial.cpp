@@ -261,7 +261,7 @@ class ClosedLoop {
       tick.frame = done[k].frame_timing;
       tick.vo = done[k].vo.timing;
       // Sequential: the simulation thread tracked the frame itself; that counts as the VO's.
-      if (!cfg_.pipeline) tick.sim_busy_s = std::max(0.0, tick.sim_busy_s - tick.voBusy());
+      if (!cfg_.pipeline) tick.sim_busy_s = std::max(0.0, tick.sim_busy_s - tick.featuresBusy() - tick.trackingBusy());
     }
     for (VoPipeline::Done& d : done) {
       const bool lost = d.vo.status == vo::TrackingStatus::kLost;

@@ -1,7 +1,8 @@
 #pragma once
 // Where a trial's flight spends its wall-clock time: per camera tick, what the simulation thread
-// did (physics, control, rendering) and waited for, and what the VO stage did with the frame;
-// summed per stage and per thread, with the critical path. Wall-clock figures only: none of it is
+// did (physics, control, rendering, noise) and waited for, and what the VO's two stages did with
+// the frame (features: ORB and back-projection; tracking: matching, PnP, local map, BA); summed
+// per stage and per thread, with the critical path. Wall-clock figures only: none of it is
 // deterministic, and none of it feeds a result that must repeat (metrics.json `timing.profile`).
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -19,12 +20,13 @@ struct TickProfile {
   bool rendered = false;    // a frame was rendered and tracked at this tick
   RgbdFrame::Timing frame;  // render, readback, convert, noise (simulation thread)
   vo::FrameResult::Timing vo;
-  double voBusy() const { return vo.total(); }
+  double featuresBusy() const { return vo.features_s; }               // the features stage
+  double trackingBusy() const { return vo.total() - vo.features_s; }  // the tracking stage
 };
 
 struct TrialProfile {
-  bool pipelined = false;       // VO on its own thread (trial.pipeline)
-  int queue_capacity = 0;       // frames the simulation may run ahead of the VO (pipelined)
+  bool pipelined = false;       // features and tracking on threads of their own (trial.pipeline)
+  int queue_capacity = 0;       // frames each stage may queue for the next (pipelined)
   bool waits_for_pose = false;  // the controller flies on the VO: tick k waits for frame k-1's pose
   int llvmpipe_threads = 0;     // LP_NUM_THREADS as the renderer saw it (0: unset, llvmpipe's default)
   int opencv_threads = 0;       // cv::getNumThreads()
@@ -35,10 +37,10 @@ struct TrialProfile {
   std::vector<TickProfile> ticks;
 
   // The critical path through the ticks: the flight's wall time as the measured work of each
-  // tick and stage implies it. Sequential, the sum of both stages. Pipelined, a replay of the
-  // pipeline: tick k's frame enters the queue once the simulation has done tick k's work and the
-  // queue has room (frame k - capacity has started tracking), the VO tracks frames in order as
-  // they arrive, and flying on the VO, tick k also waits for frame k-1's pose.
+  // tick and stage implies it. Sequential, the sum of all stages. Pipelined, a replay of the
+  // pipeline: each stage takes the frames in order, a frame leaves a stage once the next
+  // stage's queue has room (the frame `capacity` places ahead has started there), and flying on
+  // the VO, tick k also waits for frame k-1's pose.
   double criticalPathSeconds() const;
   nlohmann::ordered_json toJson() const;
 };

@@ -1,20 +1,20 @@
 #pragma once
-// The VO stage of a trial: camera noise, then tracking, frame after frame in submission order.
-// The noise is added on the submitting thread (the simulation's, which has time to spare while
-// the VO tracks), the tracking on a worker thread (threaded: the simulation renders the next
-// frames meanwhile) or inline. A frame's noise and result do not depend on the mode, so a
+// The VO stage of a trial: camera noise, feature extraction, then tracking, frame after frame in
+// submission order. The noise is added on the submitting thread (the simulation's); threaded,
+// the features and the tracking each run on a worker (the simulation renders the next frames
+// meanwhile), otherwise inline. A frame's noise and result do not depend on the mode, so a
 // pipelined trial equals a sequential one.
 #include <Eigen/Geometry>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <opencv2/core.hpp>
-#include <thread>
 #include <vector>
 
+#include "harness/base/ordered_worker.h"
 #include "harness/sim/camera.h"
 #include "vo/odometry.h"
 
@@ -29,119 +29,109 @@ class VoPipeline {
     RgbdFrame::Timing frame_timing;  // rendering and noise (wall clock; vo.timing has tracking's)
   };
 
+  // Threaded: one worker prepares the frames (ORB and back-projection, which do not depend on
+  // the odometry's state), another tracks them; each takes frames in order from a queue of
+  // kQueueCapacity.
   VoPipeline(vo::RgbdOdometry& odometry, CameraNoise& noise, bool reinitialises, bool threaded)
       : odometry_(odometry), noise_(noise), reinitialises_(reinitialises) {
-    if (threaded) worker_ = std::thread([this] { run(); });
+    if (!threaded) return;
+    tracker_ =
+        std::make_unique<OrderedWorker<Prepared>>(kQueueCapacity, [this](Prepared& p) { guarded([&] { track(p); }); });
+    preparer_ = std::make_unique<OrderedWorker<Job>>(
+        kQueueCapacity, [this](Job& job) { guarded([&] { tracker_->submit(prepare(std::move(job))); }); });
   }
-  ~VoPipeline() { stopWorker(); }
+  ~VoPipeline() {
+    preparer_.reset();  // drains into the tracker first
+    tracker_.reset();
+  }
   VoPipeline(const VoPipeline&) = delete;
   VoPipeline& operator=(const VoPipeline&) = delete;
 
-  // Adds the noise, then tracks the frame (inline) or queues it (threaded). Returns the seconds
-  // it waited for room in the queue.
+  // Adds the noise, then prepares and tracks the frame (inline) or queues it (threaded). Returns
+  // the seconds it waited for room in the queue.
   double submit(RgbdFrame frame, bool keep_image) {
     noise_.apply(&frame);
-    if (!worker_.joinable()) {
-      process(Job{std::move(frame), keep_image});
+    if (!preparer_) {
+      track(prepare(Job{std::move(frame), keep_image}));
       return 0.0;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    std::unique_lock<std::mutex> lock(mutex_);
-    // A short queue bounds memory; the simulation runs at most this far ahead of the VO.
-    changed_.wait(lock, [&] { return queue_.size() < kQueueCapacity || error_; });
-    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    rethrowLocked();
-    queue_.push_back(Job{std::move(frame), keep_image});
-    changed_.notify_all();
-    return waited;
+    preparer_->submit(Job{std::move(frame), keep_image});
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
   // The result of the k-th submitted frame, waiting for it.
   Done result(std::size_t k) {
     std::unique_lock<std::mutex> lock(mutex_);
     changed_.wait(lock, [&] { return done_.size() > k || error_; });
-    rethrowLocked();
+    if (error_) std::rethrow_exception(error_);
     return done_[k];
   }
 
-  // Frames the simulation may submit before the VO has started on them.
+  // Frames a stage may queue for the next before that one has started on them.
   static constexpr std::size_t kQueueCapacity = 3;
 
   // Whether some frame processed so far was lost for good (no re-initialisation).
   bool failedForGood() const { return failed_for_good_.load(); }
 
   std::vector<Done> finish() {
-    stopWorker();
+    if (preparer_) preparer_->finish();
+    if (tracker_) tracker_->finish();
     std::lock_guard<std::mutex> lock(mutex_);
-    rethrowLocked();
+    if (error_) std::rethrow_exception(error_);
     return std::move(done_);
   }
 
  private:
   struct Job {
     RgbdFrame frame;
-    bool keep_image;
+    bool keep_image = false;
+  };
+  struct Prepared {
+    vo::RgbdOdometry::PreparedFrame vo;
+    RgbdFrame frame;  // its images stay for the strip, the pose for the scores
+    bool keep_image = false;
   };
 
-  void process(Job job) {
+  Prepared prepare(Job job) const {
+    vo::RgbdOdometry::PreparedFrame prepared = odometry_.prepare(job.frame.t_s, job.frame.bgr, job.frame.depth_m);
+    return Prepared{std::move(prepared), std::move(job.frame), job.keep_image};
+  }
+
+  void track(const Prepared& p) {
     const bool failed_before = odometry_.failed();
-    Done d{odometry_.track(job.frame.t_s, job.frame.bgr, job.frame.depth_m), job.frame.X_WC, cv::Mat(),
-           job.frame.timing};
+    Done d{odometry_.track(p.vo), p.frame.X_WC, cv::Mat(), p.frame.timing};
     const bool first_loss = !failed_before && odometry_.failed();
-    if (job.keep_image || first_loss) d.image = job.frame.bgr;
+    if (p.keep_image || first_loss) d.image = p.frame.bgr;
     if (odometry_.failed() && !reinitialises_) failed_for_good_.store(true);
     std::lock_guard<std::mutex> lock(mutex_);
     done_.push_back(std::move(d));
     changed_.notify_all();
   }
 
-  void run() {
-    for (;;) {
-      Job job;
-      {
-        std::unique_lock<std::mutex> lock(mutex_);
-        changed_.wait(lock, [&] { return !queue_.empty() || stop_; });
-        if (queue_.empty()) return;  // stopping, all done
-        job = std::move(queue_.front());
-        queue_.pop_front();
-        changed_.notify_all();
-      }
-      try {
-        process(std::move(job));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex_);
-        error_ = std::current_exception();
-        changed_.notify_all();
-        return;
-      }
-    }
-  }
-
-  void stopWorker() {
-    if (!worker_.joinable()) return;
-    {
+  // A worker's step; its exception also reaches result(), which may be waiting.
+  template <typename Fn>
+  void guarded(Fn step) {
+    try {
+      step();
+    } catch (...) {
       std::lock_guard<std::mutex> lock(mutex_);
-      stop_ = true;
+      if (!error_) error_ = std::current_exception();
       changed_.notify_all();
+      throw;
     }
-    worker_.join();
-  }
-
-  void rethrowLocked() const {
-    if (error_) std::rethrow_exception(error_);
   }
 
   vo::RgbdOdometry& odometry_;
   CameraNoise& noise_;
   bool reinitialises_;
-  std::thread worker_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<Job> queue_;
   std::vector<Done> done_;
-  bool stop_ = false;
   std::exception_ptr error_;
   std::atomic<bool> failed_for_good_{false};
+  std::unique_ptr<OrderedWorker<Prepared>> tracker_;
+  std::unique_ptr<OrderedWorker<Job>> preparer_;
 };
 
 }  // namespace tgnav::harness

@@ -1,5 +1,6 @@
-// TrialProfile's critical path (a replay of the render/VO pipeline from measured stage times) on
-// hand-made ticks whose answer is known, and what metrics.json's `timing.profile` holds.
+// TrialProfile's critical path (a replay of the simulation / features / tracking pipeline from
+// measured stage times) on hand-made ticks whose answer is known, and what metrics.json's
+// `timing.profile` holds. The helpers' VO time is the features stage's; `ba_s` adds tracking.
 #include "harness/run/trial_profile.h"
 
 #include <gtest/gtest.h>
@@ -38,13 +39,14 @@ TEST(TrialProfile, PipelinedRunsAtTheSlowerStage) {
 // frame the simulation must wait for it.
 TEST(TrialProfile, TheQueueAbsorbsASlowFrame) {
   TrialProfile p = profile(true, 20, 0.02, 0.01);
-  p.ticks[5].vo.ba_s = 0.04;  // frame 5 (submitted at 100 ms) tracks in 50 ms
+  p.ticks[5].vo.ba_s = 0.1;  // frame 5 (submitted at 100 ms) tracks from 110 to 210 ms
   const double unhurried = 19 * 0.02 + 0.01;
   EXPECT_NEAR(p.criticalPathSeconds(), unhurried, 1e-12);
-  // Capacity 1: frame 7 (ready at 140 ms) enters the queue only once frame 6 has started, when
-  // frame 5 is done at 150 ms: the ticks slip by 10 ms.
+  // Queues of one frame: frame 6 waits in the tracking queue, frame 7 in the features stage
+  // (done at 150 ms, handed on at 210 ms), frame 8 in the features queue, and tick 9 (done at
+  // 180 ms) waits for room there until 210 ms: every later tick slips by 30 ms.
   p.queue_capacity = 1;
-  EXPECT_NEAR(p.criticalPathSeconds(), unhurried + 0.01, 1e-12);
+  EXPECT_NEAR(p.criticalPathSeconds(), unhurried + 0.03, 1e-12);
 }
 
 // Flying on the VO, tick k waits for frame k-1's pose: a slow frame the queue would absorb
@@ -79,7 +81,7 @@ TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
   }
   const nlohmann::ordered_json j = p.toJson();
   EXPECT_EQ(j["camera_ticks"], 4);
-  EXPECT_EQ(j["frames_tracked"], 4);
+  EXPECT_EQ(j["frames_processed"], 4);
   EXPECT_NEAR(j["per_frame_ms"]["readback"].get<double>(), 6.0, 1e-9);
   EXPECT_NEAR(j["per_frame_ms"]["vo_total"].get<double>(), 10.0, 1e-9);
   EXPECT_NEAR(j["per_sim_second_ms"]["physics"].get<double>(), 20.0, 1e-9);
@@ -88,15 +90,17 @@ TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
   EXPECT_NEAR(sim["wait_vo_s"].get<double>(), 0.002, 1e-12);
   EXPECT_NEAR(sim["render_s"].get<double>(), 4 * 0.008, 1e-12);
   EXPECT_NEAR(sim["other_s"].get<double>(), 0.06 - 0.004 - 0.001 - 4 * 0.009, 1e-12);
-  EXPECT_NEAR(j["threads"]["vo"]["busy_s"].get<double>(), 0.04, 1e-12);
-  EXPECT_NEAR(j["threads"]["vo"]["idle_s"].get<double>(), 0.03, 1e-12);
+  EXPECT_NEAR(j["threads"]["features"]["busy_s"].get<double>(), 0.04, 1e-12);
+  EXPECT_NEAR(j["threads"]["features"]["idle_s"].get<double>(), 0.03, 1e-12);
+  EXPECT_NEAR(j["threads"]["tracking"]["busy_s"].get<double>(), 0.0, 1e-12);
   EXPECT_EQ(j["bottleneck"], "simulation");
   EXPECT_NEAR(j["critical_path"]["total_s"].get<double>(), 3 * 0.02 + 0.01, 1e-12);
   EXPECT_NEAR(j["critical_path"]["ratio_to_wall"].get<double>(), 1.0, 1e-9);
-  // Sequential: the tracking is listed as the VO stage's, on the simulation thread.
+  // Sequential: the VO's stages are listed as such, on the simulation thread.
   p.pipelined = false;
   const nlohmann::ordered_json s = p.toJson();
-  EXPECT_TRUE(s["threads"].contains("vo_on_simulation_thread"));
+  EXPECT_TRUE(s["threads"].contains("features_on_simulation_thread"));
+  EXPECT_TRUE(s["threads"].contains("tracking_on_simulation_thread"));
   EXPECT_EQ(s["bottleneck"], "sequential");
 }
 
