@@ -18,7 +18,7 @@ struct CameraConfig {
   // Multisample anti-aliasing of the offscreen render (MuJoCo's <quality offsamples>, whose
   // default is 4): 0 renders one sample per pixel, as a real camera's pixels integrate no
   // sub-pixel geometry edges either. Overrides the model's setting.
-  int offscreen_samples = 4;
+  int offscreen_samples = 0;
 
   // The keys of configs/camera.yaml (harness/config/yaml_util.h).
   template <typename Archive>

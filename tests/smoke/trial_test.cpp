@@ -69,7 +69,8 @@ void expectTrialFolder(const std::filesystem::path& dir) {
   // The per-stage profile: every tracked frame in it, per-thread totals, the critical path.
   ASSERT_TRUE(m["timing"].contains("profile"));
   const nlohmann::json& profile = m["timing"]["profile"];
-  EXPECT_EQ(profile["frames_tracked"], m["vo_frames"]);
+  // The VO may process a few queued frames after a loss, which are not scored.
+  EXPECT_GE(profile["frames_processed"].get<int>(), m["vo_frames"].get<int>());
   for (const char* stage :
        {"render", "readback", "convert", "noise", "vo_features", "vo_matching", "vo_pnp", "vo_ba"}) {
     EXPECT_GE(profile["per_frame_ms"][stage].get<double>(), 0.0) << stage;
@@ -124,11 +125,13 @@ TEST_P(SmokeFlight, ReachesTheGoalWithVoTracking) {
   EXPECT_NEAR(m["path_length_m"].get<double>(), m["trajectory_length_m"].get<double>() + 1.0, 0.5);
 }
 
-// RRT*'s path depends on its seed: with seed 1 its path turns the camera to a plain wall near the
-// goal and the VO loses track there (a real outcome, which the trial reports as vo_lost); seed 2's
-// path stays in view of texture.
+// RRT*'s path depends on its seed and on the feature map: on the map rendered without
+// multisampling, seeds 1, 2 and 6 turn the camera to a plain wall and the VO loses track there (a
+// real outcome, which the trial reports as vo_lost, with or without multisampling in the trial's
+// own camera); seeds 3, 4 and 5 stay in view of texture. This test is about the RRT* trial
+// reaching the goal, so it flies seed 3.
 INSTANTIATE_TEST_SUITE_P(Planners, SmokeFlight,
-                         ::testing::Values(Flight{"proposed", 1}, Flight{"agnostic", 1}, Flight{"rrtstar", 2}),
+                         ::testing::Values(Flight{"proposed", 1}, Flight{"agnostic", 1}, Flight{"rrtstar", 3}),
                          [](const auto& info) { return info.param.planner; });
 
 TEST(SmokeTrial, SameSeedSameMetricsPipelinedOrNot) {
@@ -270,9 +273,10 @@ TEST(SmokeTrialCli, OracleClassIsCheckedAndRecorded) {
 
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
   const auto out = tempDir() / "trial";
-  // A long final hold keeps the vehicle flying when the signal comes.
+  // A long final hold keeps the vehicle flying when the signal comes (at 320x240 a trial runs
+  // up to 20 times faster than real time).
   const std::string cmd =
-      trialCommand("--planner agnostic" + kSmall + " --set trial.flight.hold_s=120 --out " + out.string());
+      trialCommand("--planner agnostic" + kSmall + " --set trial.flight.hold_s=1200 --out " + out.string());
   const CmdResult run = shell("(" + cmd + " & pid=$!; sleep 12; kill -INT $pid; wait $pid; echo rc=$?)");
   EXPECT_NE(run.output.find("rc=130"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("INCOMPLETE"), std::string::npos) << run.output;
