@@ -47,7 +47,7 @@ for scene in storage gallery; do
 done
 
 # Closed-loop trials: storage, proposed planner (the VO tracks the whole flight, so every frame is
-# rendered and tracked), at 640x480 and 320x240, camera and VO at 20 Hz, render and VO pipelined.
+# rendered and tracked), at 640x480 and 320x240, camera and VO at 20 Hz, the three stages pipelined.
 rm -rf "$out/trials"
 for size in 640x480 320x240; do
   "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" --map "$out/maps/storage" \
