@@ -149,7 +149,6 @@ RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig&
   require(std::isfinite(camera.cx) && std::isfinite(camera.cy), "camera.cx", camera.cx, "must be finite");
 }
 
-// A frame's features and their 3D points in the camera frame.
 // The local map's landmarks matched to a frame's keypoints, and the 2D-3D correspondences.
 struct RgbdOdometry::LocalMapMatches {
   std::vector<int> landmark_of;     // keypoint -> landmark (-1: none)
@@ -167,7 +166,7 @@ struct RgbdOdometry::PoseEstimate {
   std::vector<bool> is_inlier;  // per correspondence
 };
 
-FrameResult RgbdOdometry::track(const Frame& frame) {
+FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
   const double t_s = frame.t_s;
   if (!std::isfinite(t_s) || t_s <= last_t_) {
     std::ostringstream msg;
@@ -284,7 +283,7 @@ bool RgbdOdometry::backProject(const cv::KeyPoint& keypoint, const cv::Mat& dept
   return true;
 }
 
-FrameResult RgbdOdometry::initialise(FrameResult result, const Frame& frame) {
+FrameResult RgbdOdometry::initialise(FrameResult result, const PreparedFrame& frame) {
   if (result.with_depth < config_.init_min_features) {
     result.status = TrackingStatus::kLost;
     result.reason = std::to_string(result.with_depth) + " features with depth < " +
@@ -308,7 +307,7 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const Frame& frame) {
 }
 
 // Matches the local map's landmarks to the frame's keypoints around their predicted pixels.
-RgbdOdometry::LocalMapMatches RgbdOdometry::matchLocalMap(const Frame& frame,
+RgbdOdometry::LocalMapMatches RgbdOdometry::matchLocalMap(const PreparedFrame& frame,
                                                           const Eigen::Isometry3d& X_CW_pred) const {
   const Features& f = frame.features;
   const double radius = config_.search_radius_px;
@@ -437,7 +436,8 @@ int RgbdOdometry::refinePose(const LocalMapMatches& matches, const std::vector<c
 
 // After a tracked frame: landmark bookkeeping, a keyframe if needed, culling. Returns whether
 // the frame became a keyframe.
-bool RgbdOdometry::updateLocalMap(const Frame& frame, const LocalMapMatches& matches, const PoseEstimate& pose) {
+bool RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches,
+                                  const PoseEstimate& pose) {
   // Landmark bookkeeping: matched inliers are fresh, expected but unmatched ones age.
   std::vector<bool> seen(landmarks_.size(), false);
   std::vector<int> matched_landmark(frame.features.keypoints.size(), -1);
@@ -475,7 +475,7 @@ bool RgbdOdometry::needsKeyframe(int inliers) const {
          rotationAngle(rel.linear()) > config_.keyframe_rotation_rad;
 }
 
-void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame,
+void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame,
                                const std::vector<int>& matched_landmark, int tracked) {
   Keyframe kf;
   kf.id = next_keyframe_id_++;

@@ -168,18 +168,17 @@ class RgbdOdometry {
     int tracked = 0;                        // landmarks it tracked or created
     std::vector<Observation> observations;  // landmarks it tracked or created, where it saw them
   };
-  using Frame = PreparedFrame;
   struct LocalMapMatches;  // landmarks matched to a frame's keypoints
   struct PoseEstimate;     // PnP RANSAC and its refinement
 
   // The steps of track, in order (initialise instead of the rest for a first frame, or the
   // first after a loss with reinitialise_after_lost).
   void checkImages(const cv::Mat& image, const cv::Mat& depth_m) const;
-  FrameResult initialise(FrameResult result, const Frame& frame);
+  FrameResult initialise(FrameResult result, const PreparedFrame& frame);
   Eigen::Isometry3d predictPose() const { return X_WC_ * velocity_; }  // constant-velocity motion model
-  LocalMapMatches matchLocalMap(const Frame& frame, const Eigen::Isometry3d& X_CW_pred) const;
+  LocalMapMatches matchLocalMap(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred) const;
   PoseEstimate estimatePose(const LocalMapMatches& matches, const Eigen::Isometry3d& X_CW_pred) const;
-  bool updateLocalMap(const Frame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
+  bool updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
   FrameResult lose(FrameResult result, const std::string& why);  // where a step fails
   // Their parts.
   bool backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const;
@@ -187,7 +186,7 @@ class RgbdOdometry {
                  const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec, Eigen::Isometry3d* X_CW,
                  std::vector<bool>* is_inlier) const;
   bool needsKeyframe(int inliers) const;
-  void addKeyframe(const Eigen::Isometry3d& X_WC, const Frame& frame, const std::vector<int>& matched_landmark,
+  void addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame, const std::vector<int>& matched_landmark,
                    int tracked);
   // Local bundle adjustment after a keyframe; fills result's ba_* fields.
   void adjustLocalMap(FrameResult* result);
