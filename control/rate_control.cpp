@@ -43,7 +43,7 @@ Eigen::Vector3d RateControl::update(const Eigen::Vector3d& rate_sp, const Eigen:
   has_prev_ = true;
 
   const Eigen::Vector3d error = rate_sp - w_B;
-  const Eigen::Vector3d torque =
+  Eigen::Vector3d torque =
       config_.p.cwiseProduct(error) + integral_ - config_.d.cwiseProduct(w_dot_) + config_.ff.cwiseProduct(rate_sp);
 
   for (int a = 0; a < 3; ++a) {

@@ -1,6 +1,7 @@
 #include "planner/feature_map.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -42,10 +43,11 @@ OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min
         for (double dy = -0.5 * resolution_m + 0.5 * step; dy < 0.5 * resolution_m && !occupied; dy += step) {
           for (double z = z_lo; z <= z_hi + 1e-9 && !occupied; z += map.resolution()) {
             const Eigen::Vector3d p(c.x() + dx, c.y() + dy, z);
-            if (map.isOccupied(p))
+            if (map.isOccupied(p)) {
               occupied = true;
-            else if (!map.isKnown(p))
+            } else if (!map.isKnown(p)) {
               unseen = true;
+            }
           }
         }
       }
@@ -142,10 +144,14 @@ std::vector<int> FeatureMap::inHorizontalFov(const Eigen::Vector3d& p_W, double 
 }
 
 void FeatureMap::save(const std::filesystem::path& dir) const {
+  // A stream's last bytes reach the file at close(): each file is checked after it.
+  auto fail = [](const std::filesystem::path& file) {
+    throw std::runtime_error(file.string() + ": cannot write: " + std::strerror(errno));
+  };
   std::ofstream bt(dir / "map.bt", std::ios::binary | std::ios::trunc);
-  if (!bt || !tree_->writeBinaryConst(bt) || !bt.flush()) {
-    throw std::runtime_error((dir / "map.bt").string() + ": cannot write");
-  }
+  if (!bt || !tree_->writeBinaryConst(bt)) fail(dir / "map.bt");
+  bt.close();
+  if (!bt) fail(dir / "map.bt");
   std::ofstream out(dir / "landmarks.csv");
   out << "id,x,y,z,observations,ref_x,ref_y,ref_z,voxel_x,voxel_y,voxel_z,descriptor\n";
   out.precision(6);
@@ -163,7 +169,8 @@ void FeatureMap::save(const std::filesystem::path& dir) const {
         << lm.ref_kf_p_W.x() << ',' << lm.ref_kf_p_W.y() << ',' << lm.ref_kf_p_W.z() << ',' << v.x() << ',' << v.y()
         << ',' << v.z() << ',' << hex << '\n';
   }
-  if (!out) throw std::runtime_error((dir / "landmarks.csv").string() + ": cannot write");
+  out.close();
+  if (!out) fail(dir / "landmarks.csv");
 }
 
 FeatureMap FeatureMap::load(const std::filesystem::path& dir) {
@@ -198,7 +205,8 @@ FeatureMap FeatureMap::load(const std::filesystem::path& dir) {
     try {
       for (int k = 0; k < 10; ++k) v[k] = std::stod(f[k + 1]);
       for (int b = 0; b < 32; ++b) {
-        lm.descriptor[b] = static_cast<std::uint8_t>(std::stoi(f[11].substr(2 * b, 2), nullptr, 16));
+        lm.descriptor[b] =
+            static_cast<std::uint8_t>(std::stoi(f[11].substr(2 * static_cast<std::size_t>(b), 2), nullptr, 16));
       }
     } catch (const std::exception&) {
       throw std::runtime_error(csv + ":" + std::to_string(line_no) + ": malformed number or descriptor");

@@ -36,10 +36,11 @@ std::vector<Pose4> headingPath(const std::vector<Eigen::Vector3d>& path, double 
   double yaw = start_yaw;
   for (std::size_t i = 0; i < path.size(); ++i) {
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    if (i + 1 < path.size())
+    if (i + 1 < path.size()) {
       d = path[i + 1] - path[i];
-    else if (i > 0)
+    } else if (i > 0) {
       d = path[i] - path[i - 1];
+    }
     if (d.head<2>().norm() > 1e-9) yaw = std::atan2(d.y(), d.x());
     out.push_back({path[i], yaw});
   }

@@ -88,6 +88,14 @@ class Planner {
   // a given request.
   virtual Plan solve(const PlanRequest& request) const = 0;
   virtual const char* name() const = 0;  // toString of its kind
+
+ protected:
+  // Copied and moved only as part of a derived planner (no slicing).
+  Planner() = default;
+  Planner(const Planner&) = default;
+  Planner& operator=(const Planner&) = default;
+  Planner(Planner&&) = default;
+  Planner& operator=(Planner&&) = default;
 };
 
 // The planner of `kind` on `voxels`, which must outlive it: proposed and AP take `perception`, RRT*

@@ -248,7 +248,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
 
   for (int j = 0; j + 1 < layers; ++j) {
     const auto& from = positions[static_cast<std::size_t>(j)];
-    const auto& to = positions[static_cast<std::size_t>(j + 1)];
+    const auto& to = positions[static_cast<std::size_t>(j) + 1];
     auto& edges = dag.edges[static_cast<std::size_t>(j)];
     edges.reserve(from.size() * to.size() * static_cast<std::size_t>(yaws * (2 * max_yaw_steps + 1)));
     for (std::size_t a = 0; a < from.size(); ++a) {

@@ -146,6 +146,10 @@ class XyGoal : public ob::GoalSampleableRegion {
     setThreshold(tolerance);
   }
   ~XyGoal() override { si_->freeState(goal_); }
+  XyGoal(const XyGoal&) = delete;  // owns goal_
+  XyGoal& operator=(const XyGoal&) = delete;
+  XyGoal(XyGoal&&) = delete;
+  XyGoal& operator=(XyGoal&&) = delete;
 
   double distanceGoal(const ob::State* st) const override { return planarDistance(st, goal_); }
   void sampleGoal(ob::State* st) const override { si_->copyState(st, goal_); }

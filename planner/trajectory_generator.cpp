@@ -470,7 +470,7 @@ void checkRequest(const TrajectoryRequest& request, const TrajectoryConfig& conf
 void pathClearance(const std::vector<Eigen::Vector3d>& path, const ClearanceField& field, double* clearance,
                    Eigen::Vector3d* closest) {
   for (std::size_t k = 0; k < path.size(); ++k) {
-    const Eigen::Vector3d a = path[k];
+    const Eigen::Vector3d& a = path[k];
     const Eigen::Vector3d b = k + 1 < path.size() ? path[k + 1] : a;
     const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.01)));
     for (int i = 0; i < steps; ++i) {
@@ -595,8 +595,9 @@ SplineStart startSplines(const Reference& ref, const TrajectoryConfig& config) {
   }
   s.fixed_p.assign(static_cast<std::size_t>(n), false);
   s.fixed_y.assign(static_cast<std::size_t>(n), false);
-  for (int i : {0, 1, 2, n - 3, n - 2, n - 1})
+  for (int i : {0, 1, 2, n - 3, n - 2, n - 1}) {
     s.fixed_p[static_cast<std::size_t>(i)] = s.fixed_y[static_cast<std::size_t>(i)] = true;
+  }
   holdStillWhileTurning(ref, &s);
   return s;
 }

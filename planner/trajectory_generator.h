@@ -48,6 +48,14 @@ class ClearanceField {
   // Clearance [m] of p (<= 0: in an obstacle or outside the map); `gradient` (may be null) gets
   // its gradient (zero where it is not defined).
   virtual double clearance(const Eigen::Vector3d& p_W, Eigen::Vector3d* gradient) const = 0;
+
+ protected:
+  // Copied and moved only as part of a derived field (no slicing).
+  ClearanceField() = default;
+  ClearanceField(const ClearanceField&) = default;
+  ClearanceField& operator=(const ClearanceField&) = default;
+  ClearanceField(ClearanceField&&) = default;
+  ClearanceField& operator=(ClearanceField&&) = default;
 };
 
 // The scene's 3D voxel map (only answers within its clearance band; 0 above and below).
@@ -124,6 +132,14 @@ class Trajectory {
   virtual ~Trajectory() = default;
   virtual double duration() const = 0;
   virtual TrajectorySample at(double t_s) const = 0;  // clamped to [0, duration()]
+
+ protected:
+  // Copied and moved only as part of a derived trajectory (no slicing).
+  Trajectory() = default;
+  Trajectory(const Trajectory&) = default;
+  Trajectory& operator=(const Trajectory&) = default;
+  Trajectory(Trajectory&&) = default;
+  Trajectory& operator=(Trajectory&&) = default;
 };
 
 // Optimised: position and yaw B-splines on the same knots.

@@ -241,8 +241,10 @@ double VoxelMap::clearance(const Eigen::Vector3d& p_W, Eigen::Vector3d* gradient
       for (int dx = -1; dx <= 1; ++dx) {
         const int s = site_[padded(c + Eigen::Vector3i(dx, dy, dz))];
         if (s < 0) continue;
-        const Eigen::Vector3d centre =
-            origin_ + res_ * Eigen::Vector3d(s % nx - 0.5, (s / nx) % ny - 0.5, s / (nx * ny) - 0.5 + edt_z0_);
+        const int ix = s % nx;  // the site's cell indices
+        const int iy = (s / nx) % ny;
+        const int iz = s / (nx * ny);
+        const Eigen::Vector3d centre = origin_ + res_ * Eigen::Vector3d(ix - 0.5, iy - 0.5, iz - 0.5 + edt_z0_);
         const Eigen::Vector3d r = p_W - centre;
         // From the nearest point of the obstacle cube to p.
         const Eigen::Vector3d d = (r.cwiseAbs().array() - half).cwiseMax(0.0).matrix().cwiseProduct(r.cwiseSign());

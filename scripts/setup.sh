@@ -18,6 +18,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-matplotlib                  # every figure (scripts/tgnav_plots.py)
   clang-format-14                     # the style check (scripts/check_format.sh, CTest format.check)
+  clang-14 libclang-rt-14-dev clang-tidy-14  # sanitizers, libFuzzer, clang-tidy (scripts/sanitize.sh, tidy.sh)
   slurmctld slurmd slurm-client munge # the Slurm sweep backend's test (a private single-node cluster)
 )
 

@@ -154,7 +154,7 @@ std::array<double, 6> toParameters(const Eigen::Isometry3d& X_CW) {
   const Eigen::Vector3d r = aa.angle() * aa.axis();
   for (int i = 0; i < 3; ++i) {
     p[static_cast<std::size_t>(i)] = r[i];
-    p[static_cast<std::size_t>(i + 3)] = X_CW.translation()[i];
+    p[static_cast<std::size_t>(i) + 3] = X_CW.translation()[i];
   }
   return p;
 }

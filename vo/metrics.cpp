@@ -345,8 +345,9 @@ RpeStatistics rpeStatistics(const std::vector<PosePair>& pairs, double delta, Rp
 
 double pathLength(const std::vector<StampedPose>& poses) {
   double d = 0.0;
-  for (std::size_t k = 1; k < poses.size(); ++k)
+  for (std::size_t k = 1; k < poses.size(); ++k) {
     d += (poses[k].X_WC.translation() - poses[k - 1].X_WC.translation()).norm();
+  }
   return d;
 }
 

@@ -42,11 +42,11 @@ class KeypointGrid {
       : cell_(cell_px),
         cols_(std::max(1, static_cast<int>(std::ceil(width / cell_px)))),
         rows_(std::max(1, static_cast<int>(std::ceil(height / cell_px)))),
-        cells_(static_cast<std::size_t>(cols_ * rows_)) {
+        cells_(static_cast<std::size_t>(cols_) * static_cast<std::size_t>(rows_)) {
     for (std::size_t i = 0; i < keypoints.size(); ++i) {
       const int cx = std::clamp(static_cast<int>(keypoints[i].pt.x / cell_), 0, cols_ - 1);
       const int cy = std::clamp(static_cast<int>(keypoints[i].pt.y / cell_), 0, rows_ - 1);
-      cells_[static_cast<std::size_t>(cy * cols_ + cx)].push_back(static_cast<int>(i));
+      cells_[cellIndex(cx, cy)].push_back(static_cast<int>(i));
     }
   }
   template <typename Fn>
@@ -55,12 +55,17 @@ class KeypointGrid {
     const int cy = static_cast<int>(std::floor(v / cell_));
     for (int y = std::max(0, cy - 1); y <= std::min(rows_ - 1, cy + 1); ++y) {
       for (int x = std::max(0, cx - 1); x <= std::min(cols_ - 1, cx + 1); ++x) {
-        for (int i : cells_[static_cast<std::size_t>(y * cols_ + x)]) fn(i);
+        for (int i : cells_[cellIndex(x, y)]) fn(i);
       }
     }
   }
 
  private:
+  // The cell of column x, row y (both in range, so not negative), widened before multiplying.
+  std::size_t cellIndex(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(cols_) + static_cast<std::size_t>(x);
+  }
+
   double cell_;
   int cols_;
   int rows_;

@@ -22,6 +22,8 @@ class OrderedWorker {
   ~OrderedWorker() { stop(); }
   OrderedWorker(const OrderedWorker&) = delete;
   OrderedWorker& operator=(const OrderedWorker&) = delete;
+  OrderedWorker(OrderedWorker&&) = delete;  // owns a thread that captures `this`
+  OrderedWorker& operator=(OrderedWorker&&) = delete;
 
   void submit(T item) {
     std::unique_lock<std::mutex> lock(mutex_);

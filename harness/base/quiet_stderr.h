@@ -23,6 +23,8 @@ class QuietStderr {
   }
   QuietStderr(const QuietStderr&) = delete;
   QuietStderr& operator=(const QuietStderr&) = delete;
+  QuietStderr(QuietStderr&&) = delete;  // owns the saved stderr fd
+  QuietStderr& operator=(QuietStderr&&) = delete;
 
  private:
   int saved_;

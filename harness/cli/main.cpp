@@ -7,7 +7,11 @@
 #include "harness/base/errors.h"
 #include "harness/cli/cli.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+// Parses the command line and runs the command; the exit code. Exceptions other than the ones
+// that name a bad command line or input go on to main().
+int runCommandLine(int argc, char** argv) {
   CLI::App app{"tgnav: topology-guided, perception-aware MAV navigation in MuJoCo, closed loop"};
   app.require_subcommand(1);
   app.failure_message([](const CLI::App*, const CLI::Error& e) {
@@ -34,9 +38,20 @@ int main(int argc, char** argv) {
   } catch (const tgnav::InputError& e) {
     std::fprintf(stderr, "tgnav: error: %s\n", tgnav::oneLine(e.what()).c_str());
     return 2;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return runCommandLine(argc, argv);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tgnav: internal error: %s\n", tgnav::oneLine(e.what()).c_str());
     return 1;
+  } catch (...) {
+    std::fprintf(stderr, "tgnav: internal error: unknown exception\n");
+    return 1;
   }
-  return 0;
 }

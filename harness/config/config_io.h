@@ -26,10 +26,10 @@ inline control::CascadeConfig loadCascadeConfig(const std::filesystem::path& yam
   return loadConfigFile(yaml, std::move(base));
 }
 inline vo::OdometryConfig loadOdometryConfig(const std::filesystem::path& yaml, vo::OdometryConfig base = {}) {
-  return loadConfigFile(yaml, std::move(base));
+  return loadConfigFile(yaml, base);
 }
 inline TrialConfig loadTrialConfig(const std::filesystem::path& yaml, TrialConfig base = {}) {
-  return loadConfigFile(yaml, std::move(base));
+  return loadConfigFile(yaml, base);
 }
 
 }  // namespace tgnav::harness

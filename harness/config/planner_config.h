@@ -46,7 +46,7 @@ struct PlannerSettings {
 
 // A planner.yaml read over `base`, then validated (InputError naming the file).
 inline PlannerSettings loadPlannerSettings(const std::filesystem::path& yaml, PlannerSettings base = {}) {
-  return loadConfigFile(yaml, std::move(base));
+  return loadConfigFile(yaml, base);
 }
 
 }  // namespace tgnav::harness

@@ -24,7 +24,7 @@ std::vector<std::string> sectionKeys() {
 
 fs::path existingFile(const YamlDoc& doc, const std::string& key, const fs::path& base) {
   const std::string text = doc.string(doc.root(), key, "");
-  const fs::path p = fs::absolute(base / text).lexically_normal();
+  fs::path p = fs::absolute(base / text).lexically_normal();
   if (!fs::is_regular_file(p)) {
     doc.failKey(doc.root()[key], key, "key '" + key + "' has value '" + text + "': file " + p.string() + " not found");
   }

@@ -170,7 +170,7 @@ void YamlDoc::requireKeys(const YAML::Node& map, const std::vector<std::string>&
   }
 }
 
-const YAML::Node YamlDoc::child(const YAML::Node& map, const std::string& key, const std::string& context) const {
+YAML::Node YamlDoc::child(const YAML::Node& map, const std::string& key, const std::string& context) const {
   const YAML::Node node = map[key];
   if (!node) failKey(map, joinKey(context, key), "missing required key '" + joinKey(context, key) + "'");
   return node;
@@ -224,20 +224,20 @@ std::vector<double> YamlDoc::numbers(const YAML::Node& map, const std::string& k
   return out;
 }
 
-YamlArchive::YamlArchive(const YamlDoc& doc, YAML::Node map, std::string context)
-    : doc_(&doc), map_(std::move(map)), context_(std::move(context)) {
+YamlArchive::YamlArchive(const YamlDoc& doc, const YAML::Node& map, std::string context)
+    : doc_(&doc), map_(map), context_(std::move(context)) {
   if (!map_.IsMap()) {
     doc_->failKey(map_, context_, "'" + (context_.empty() ? std::string("<root>") : context_) + "' must be a mapping");
   }
 }
 
-YamlArchive::YamlArchive(YAML::Node out, std::string context)
-    : doc_(nullptr), map_(std::move(out)), context_(std::move(context)) {
+YamlArchive::YamlArchive(const YAML::Node& out, std::string context)
+    : doc_(nullptr), map_(out), context_(std::move(context)) {
   if (!map_.IsMap()) map_ = YAML::Node(YAML::NodeType::Map);
 }
 
-YamlArchive YamlArchive::writer(YAML::Node out, std::string context) {
-  return YamlArchive(std::move(out), std::move(context));
+YamlArchive YamlArchive::writer(const YAML::Node& out, std::string context) {
+  return YamlArchive(out, std::move(context));
 }
 
 void YamlArchive::missing(const std::string& key) const {

@@ -53,7 +53,7 @@ class YamlDoc {
   std::string string(const YAML::Node& map, const std::string& key, const std::string& context) const;
   std::vector<double> numbers(const YAML::Node& map, const std::string& key, std::size_t count,
                               const std::string& context) const;
-  const YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& context) const;
+  YAML::Node child(const YAML::Node& map, const std::string& key, const std::string& context) const;
 
  private:
   struct Assignment {
@@ -237,9 +237,9 @@ class SkipKeys {
 class YamlArchive {
  public:
   // Reading `map` (which must be a mapping) of `doc`; `context` is its dotted key ("" = root).
-  YamlArchive(const YamlDoc& doc, YAML::Node map, std::string context);
+  YamlArchive(const YamlDoc& doc, const YAML::Node& map, std::string context);
   // Writing into `out` (made a mapping).
-  static YamlArchive writer(YAML::Node out, std::string context = "");
+  static YamlArchive writer(const YAML::Node& out, std::string context = "");
   bool writing() const { return doc_ == nullptr; }
   bool reading() const { return doc_ != nullptr; }
   // Reading: every key a visit names must be present ("missing required key 'a.b'"), in nested
@@ -328,7 +328,7 @@ class YamlArchive {
   void finish() const;
 
  private:
-  YamlArchive(YAML::Node out, std::string context);  // a writer
+  YamlArchive(const YAML::Node& out, std::string context);  // a writer
 
   // Reading: rejects the keys `visit_keys` does not name, then reads them; writing: writes them.
   template <typename Fn>

@@ -347,6 +347,7 @@ TableRow tableRow(const ReportGroup& group, const std::vector<IndexRow>& rows) {
 
 std::vector<TableRow> tableRows(const std::vector<ReportGroup>& groups, const std::vector<IndexRow>& rows) {
   std::vector<TableRow> out;
+  out.reserve(groups.size());
   for (const ReportGroup& g : groups) out.push_back(tableRow(g, rows));
   return out;
 }

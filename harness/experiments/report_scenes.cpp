@@ -1,6 +1,7 @@
 #include "harness/experiments/report_scenes.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 #include <sstream>
@@ -75,7 +76,8 @@ void addPlanners(SceneReport& scene, const std::vector<IndexRow>& rows) {
   for (std::size_t i = 0; i < goals.size(); ++i) scene.planners[i].goal_error_median_m = median(goals[i]);
 }
 
-std::string percent(int k, int n) { return std::to_string(static_cast<int>(100.0 * k / n + 0.5)) + "%"; }
+// 0 <= k <= n and n > 0 (formatShare), so the share is in [0, 100]: lround is the old (int)(x + 0.5).
+std::string percent(int k, int n) { return std::to_string(static_cast<int>(std::lround(100.0 * k / n))) + "%"; }
 
 std::string classList(const std::vector<int>& classes) {
   std::string out;

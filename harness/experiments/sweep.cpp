@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "harness/base/errors.h"
 #include "harness/base/shell.h"
@@ -93,7 +94,7 @@ struct Assignments {
 };
 
 void checkSettingKey(const YamlDoc& doc, const YAML::Node& key_node, const std::string& context) {
-  const std::string key = key_node.Scalar();
+  const std::string& key = key_node.Scalar();
   if (key == "seed") doc.fail(key_node, context + ": key 'seed': give seeds with the sweep's 'seeds'");
   if (key.empty() || key.find('=') != std::string::npos || key.find(' ') != std::string::npos) {
     doc.fail(key_node, context + ": '" + key + "' is not a dotted config key");
@@ -152,6 +153,7 @@ struct Checked {
 Checked checkConfig(const YamlDoc& doc, const YAML::Node& where, const std::string& context, const fs::path& scenario,
                     const std::vector<std::pair<std::string, std::string>>& set) {
   std::vector<std::string> assignments;
+  assignments.reserve(set.size());
   for (const auto& [key, value] : set) assignments.push_back(key + "=" + value);
   try {
     const YamlDoc overrides = YamlDoc::fromOverrides(assignments);

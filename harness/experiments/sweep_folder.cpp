@@ -212,6 +212,7 @@ std::vector<SweepTrial> SweepDir::manifest() const {
 
 std::vector<TrialFolder> SweepDir::inspect(const std::vector<SweepTrial>& trials) const {
   std::vector<TrialFolder> folders;
+  folders.reserve(trials.size());
   for (const SweepTrial& t : trials) folders.push_back(inspectTrialFolder(t, trialDir(t)));
   return folders;
 }

@@ -15,6 +15,8 @@ namespace tgnav::harness {
 
 // What a trial folder holds.
 enum class TrialState { kAbsent, kIncomplete, kCorrupt, kDone };
+// False positive: clang-tidy 14 takes the implicit default constructor for noexcept (it is not: json's can throw).
+// NOLINTNEXTLINE(bugprone-exception-escape)
 struct TrialFolder {
   TrialState state = TrialState::kAbsent;
   std::string problem;     // kIncomplete / kCorrupt: what is wrong, one line
@@ -55,6 +57,8 @@ class FolderLock {
   ~FolderLock();
   FolderLock(const FolderLock&) = delete;
   FolderLock& operator=(const FolderLock&) = delete;
+  FolderLock(FolderLock&&) = delete;  // owns the lock's fd
+  FolderLock& operator=(FolderLock&&) = delete;
 
  private:
   int fd_ = -1;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
@@ -28,7 +29,8 @@ using Clock = std::chrono::steady_clock;
 
 std::string formatDuration(double s) {
   char buf[32];
-  const long t = static_cast<long>(s + 0.5);
+  // floor(s + 0.5), not lround(s): the same value as the old (long)(s + 0.5) for every s >= -0.5.
+  const long t = static_cast<long>(std::floor(s + 0.5));
   if (t >= 3600) {
     std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
   } else if (t >= 60) {
@@ -87,6 +89,7 @@ pid_t spawnTrial(const fs::path& exe, const std::vector<std::string>& args, cons
   std::vector<std::string> argv_s{exe.string()};
   argv_s.insert(argv_s.end(), args.begin(), args.end());
   std::vector<char*> argv;
+  argv.reserve(argv_s.size() + 1);
   for (std::string& a : argv_s) argv.push_back(a.data());
   argv.push_back(nullptr);
   appendLogHeader(log, argv_s);

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
@@ -51,7 +52,7 @@ void checkSweepFolder(const SweepDir& dir) {
 
 fs::path selfExe() {
   std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (ec) throw std::runtime_error("cannot find the tgnav program (/proc/self/exe): " + ec.message());
   return exe;
 }
@@ -63,14 +64,15 @@ void prebuildMaps(const SweepRun& run) {
   const fs::path cache = run.map_cache.empty() ? defaultCacheDir() : fs::path(run.map_cache);
   for (const auto& [scene, trial] : scenes) {
     std::vector<std::string> set;  // the trial's own settings: one may name another scene
+    set.reserve(trial->set.size());
     for (const auto& [key, value] : trial->set) set.push_back(key + "=" + value);
     const YamlDoc overrides = YamlDoc::fromOverrides(set);
     const Scenario s = loadScenario(trial->scenario, &overrides);
     bool told = false;
+    const std::string& name = scene;  // a structured binding cannot be captured (C++17)
     cachedFeatureMap(s.scene, MapBuildConfig{}, cache, [&](int, int) {
       if (!told) {
-        std::fprintf(stderr, "tgnav sweep: building the feature map of %s (once; the trials share it)\n",
-                     scene.c_str());
+        std::fprintf(stderr, "tgnav sweep: building the feature map of %s (once; the trials share it)\n", name.c_str());
         told = true;
       }
     });

@@ -42,7 +42,7 @@ std::string firstDifference(const scenes::GeneratedScene& scene, const fs::path&
 fs::path ensureScene(const YamlDoc& doc, const YAML::Node& where, const std::string& key, SceneKind kind,
                      std::uint64_t seed, GeneratedScenes* generated) {
   const std::string name = scenes::sceneName(kind, seed);
-  const fs::path scenario = generated->dir / name / scenes::scenarioFile(kind, seed);
+  fs::path scenario = generated->dir / name / scenes::scenarioFile(kind, seed);
   if (!generated->ensured.insert(name).second) return scenario;
   const scenes::GeneratedScene scene = scenes::generateScene(kind, seed);
   const fs::path dir = generated->dir / name;
@@ -86,8 +86,9 @@ std::vector<fs::path> readGeneratedScenes(const YamlDoc& doc, const YAML::Node& 
       doc.fail(kind_node, e.what());
     }
     const YAML::Node seeds = entry["seeds"];
-    if (!seeds.IsSequence() || seeds.size() == 0)
+    if (!seeds.IsSequence() || seeds.size() == 0) {
       doc.fail(seeds, joinKey(key, "seeds") + ": expected a non-empty list");
+    }
     for (const YAML::Node& s : seeds) {
       std::uint64_t seed = 0;
       try {

@@ -98,7 +98,7 @@ std::string submit(const std::string& cmd, const fs::path& script) {
   // sbatch --parsable prints "JOBID" or "JOBID;CLUSTER" first; with --wait it returns the
   // array's exit code once every task has ended.
   const std::string first = r.output.substr(0, r.output.find('\n'));
-  const std::string job = first.substr(0, first.find(';'));
+  std::string job = first.substr(0, first.find(';'));
   if (job.empty() || !std::all_of(job.begin(), job.end(), ::isdigit)) {
     fs::remove(script);
     throw InputError("sbatch failed (exit " + std::to_string(r.rc) + "): " + oneLine(r.output) +

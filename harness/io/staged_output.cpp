@@ -1,7 +1,11 @@
 #include "harness/io/staged_output.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <system_error>
@@ -21,15 +25,26 @@ void makeOutputDir(const std::filesystem::path& dir) {
 
 void writeFileAtomic(const std::filesystem::path& file, const std::string& content) {
   const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(tmp, ignored);
-      throw InputError(file.string() + ": cannot write file");
+  // POSIX calls, so that a failure says why (a full disk: "No space left on device").
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw InputError(file.string() + ": cannot write file: " + std::strerror(errno));
+  const char* p = content.data();
+  std::size_t left = content.size();
+  int error = 0;
+  while (left > 0 && error == 0) {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) error = errno;
+    if (n > 0) {
+      p += n;
+      left -= static_cast<std::size_t>(n);
     }
+  }
+  if (::close(fd) != 0 && error == 0) error = errno;
+  if (error != 0) {
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw InputError(file.string() + ": cannot write file: " + std::strerror(error));
   }
   std::error_code ec;
   std::filesystem::rename(tmp, file, ec);

@@ -44,6 +44,8 @@ class StagedDir {
   ~StagedDir();  // removes the staging folder unless it was committed or kept
   StagedDir(const StagedDir&) = delete;
   StagedDir& operator=(const StagedDir&) = delete;
+  StagedDir(StagedDir&&) = delete;  // owns the staging folder
+  StagedDir& operator=(StagedDir&&) = delete;
 
   const std::filesystem::path& staging() const { return staging_; }  // write here
   const std::filesystem::path& target() const { return target_; }

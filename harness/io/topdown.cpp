@@ -90,8 +90,9 @@ void writeMapLayer(const std::filesystem::path& dir, const MapLayer& layer) {
   j["goal_xy"] = xy(layer.goal_xy);
   j["title"] = layer.title;
   j["legend"] = nlohmann::json::array();
-  for (const auto& [label, rgb] : layer.legend)
+  for (const auto& [label, rgb] : layer.legend) {
     j["legend"].push_back({{"label", label}, {"rgb", {rgb[0], rgb[1], rgb[2]}}});
+  }
   writeImageAtomic(dir / "map.png", layer.image);
   writeFileAtomic(dir / "map.json", j.dump(2) + "\n");
 }

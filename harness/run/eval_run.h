@@ -26,6 +26,8 @@ struct EvalJob {
   FigureFormat figure_format = FigureFormat::kPng;
 };
 
+// False positive: clang-tidy 14 takes the implicit default constructor for noexcept (it is not: json's can throw).
+// NOLINTNEXTLINE(bugprone-exception-escape)
 struct EvalResult {
   nlohmann::ordered_json summary;  // eval.json's content (also without an output folder)
   std::filesystem::path out;       // the folder written; empty when none was asked for

@@ -84,6 +84,15 @@ std::string mapKey(const SceneConfig& scene, const MapBuildConfig& config) {
   return hex;
 }
 
+void saveFeatureMap(const planner::FeatureMap& map, const std::filesystem::path& dir) {
+  const QuietStderr quiet;  // OctoMap's writer logs to stderr
+  try {
+    map.save(dir);
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
+}
+
 CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& config,
                            const std::filesystem::path& cache_root,
                            const std::function<void(int done, int total)>& progress) {
@@ -98,10 +107,7 @@ CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& confi
   MapBuildStats stats;
   const planner::FeatureMap map = buildFeatureMap(scene, config, &stats, progress);
   StagedDir staged(out.dir, "map cache");
-  {
-    const QuietStderr quiet;
-    map.save(staged.staging());
-  }
+  saveFeatureMap(map, staged.staging());
   nlohmann::ordered_json j;
   j["scene"] = scene.source.string();
   j["landmarks"] = stats.landmarks;

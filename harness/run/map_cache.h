@@ -25,6 +25,10 @@ struct CachedMap {
   bool built = false;         // false: found in the cache
 };
 
+// Writes map.bt and landmarks.csv into `dir` (a staging folder): InputError naming the file and
+// the system's reason when it cannot (a full disk).
+void saveFeatureMap(const planner::FeatureMap& map, const std::filesystem::path& dir);
+
 // The map's folder under cache_root/maps/<scene>-<key>, building it when absent.
 CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& config,
                            const std::filesystem::path& cache_root,

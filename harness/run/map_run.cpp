@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "harness/base/errors.h"
-#include "harness/base/quiet_stderr.h"
 #include "harness/io/staged_output.h"
 #include "harness/io/topdown.h"
+#include "harness/run/map_cache.h"
 
 namespace tgnav::harness {
 
@@ -37,7 +37,7 @@ nlohmann::ordered_json summaryJson(const SceneConfig& scene, const MapBuildConfi
 
 // A new folder, or one holding an earlier map; never the working directory or a parent of it.
 fs::path checkedOutput(const fs::path& requested) {
-  const fs::path out = fs::absolute(requested).lexically_normal();
+  fs::path out = fs::absolute(requested).lexically_normal();
   const fs::path cwd = fs::current_path();
   if (out == cwd || out == out.root_path() || !out.has_filename() ||
       std::mismatch(out.begin(), out.end(), cwd.begin(), cwd.end()).first == out.end()) {
@@ -64,16 +64,14 @@ MapRunResult runMap(const MapJob& job) {
   MapRunResult result;
   result.out = checkedOutput(job.out);
   const planner::FeatureMap map = buildFeatureMap(scene, config, &result.stats, [&](int done, int total) {
-    if (job.progress && (done % 20 == 0 || done == total))
+    if (job.progress && (done % 20 == 0 || done == total)) {
       std::fprintf(stderr, "\rtgnav map: %d/%d frames", done, total);
+    }
   });
   if (job.progress) std::fprintf(stderr, "\n");
 
   StagedDir staged(result.out);
-  {
-    const QuietStderr quiet;
-    map.save(staged.staging());
-  }
+  saveFeatureMap(map, staged.staging());
   writeMapLayer(staged.staging(), sceneMapLayer(scene, map, kRasterBandM));
   writeFileAtomic(staged.staging() / "summary.json", summaryJson(scene, config, result.stats).dump(2) + "\n");
   result.figures = drawFigures("map", staged.staging(), job.figure_format);

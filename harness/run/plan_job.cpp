@@ -40,8 +40,9 @@ MapLayer gridLayer(const planner::OccupancyGrid2D& grid, const planner::TopoPlan
   layer.image = cv::Mat(grid.height * scale, grid.width * scale, CV_8UC3, cv::Scalar(255, 255, 255));
   for (int iy = 0; iy < grid.height; ++iy) {
     for (int ix = 0; ix < grid.width; ++ix) {
-      if (grid.isOccupied(ix, iy))
+      if (grid.isOccupied(ix, iy)) {
         layer.image(cv::Rect(ix * scale, (grid.height - 1 - iy) * scale, scale, scale)).setTo(cv::Scalar(70, 70, 70));
+      }
     }
   }
   // The GVD lives on the planner's working grid, k x k cells per map cell.

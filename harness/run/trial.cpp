@@ -173,8 +173,9 @@ class ClosedLoop {
     const mjData* d = data_.get();
     const Eigen::Vector3d p = l.state().p_WB;
     int partner = -1;
-    for (int i = 0; i < d->ncon && partner < 0; ++i)
+    for (int i = 0; i < d->ncon && partner < 0; ++i) {
       partner = contactPartner(model_.get(), d->contact[i], vehicle_root_);
+    }
     if (p.z() > landed_.p_WB.z() + kLiftOffM) airborne_ = true;
     if (partner >= 0 && airborne_) {
       result_->collision = TrialEvent{l.time(), p, geomName(model_.get(), partner)};

@@ -46,6 +46,8 @@ class VoPipeline {
   }
   VoPipeline(const VoPipeline&) = delete;
   VoPipeline& operator=(const VoPipeline&) = delete;
+  VoPipeline(VoPipeline&&) = delete;  // its workers capture `this`
+  VoPipeline& operator=(VoPipeline&&) = delete;
 
   // Adds the noise, then prepares and tracks the frame (inline) or queues it (threaded). Returns
   // the seconds it waited for room in the queue.

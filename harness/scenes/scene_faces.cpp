@@ -32,9 +32,10 @@ struct FaceWriter {
     if (face == Face::kMinusX) cv::rotate(image, image, cv::ROTATE_90_CLOCKWISE);
     if (face == Face::kPlusX) cv::rotate(image, image, cv::ROTATE_90_COUNTERCLOCKWISE);
     std::vector<uchar> png;
-    if (!cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 6}))
+    if (!cv::imencode(".png", image, png, {cv::IMWRITE_PNG_COMPRESSION, 6})) {
       throw std::runtime_error("cannot encode a PNG texture");
-    const std::string name = b.name + "_" + kSuffix[static_cast<int>(face)] + ".png";
+    }
+    std::string name = b.name + "_" + kSuffix[static_cast<int>(face)] + ".png";
     files["textures/" + name] = std::string(png.begin(), png.end());
     return name;
   }

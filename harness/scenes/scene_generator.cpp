@@ -103,8 +103,9 @@ void writeGeneratedScene(const GeneratedScene& scene, const std::filesystem::pat
   checkSceneOutput(dir);
   const bool existed = std::filesystem::exists(dir);  // empty: the files are moved into it
   StagedDir staged(dir);
-  for (const char* sub : {"textures", "scenes", "scenarios"})
+  for (const char* sub : {"textures", "scenes", "scenarios"}) {
     std::filesystem::create_directories(staged.staging() / sub);
+  }
   for (const auto& [name, bytes] : scene.files) writeFileAtomic(staged.staging() / name, bytes);
   staged.commit(existed ? OnExisting::kMerge : OnExisting::kRefuse, "generating the scene");
 }

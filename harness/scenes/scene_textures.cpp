@@ -92,6 +92,7 @@ void drawShape(Canvas& canvas, double width_m, double height_m, double size_m, c
   const int type = rng.uniformInt(0, 3);
   if (type == 0) {
     std::vector<double> a;
+    a.reserve(28);
     for (int k = 0; k < 28; ++k) a.push_back(2.0 * kPi * k / 28);
     canvas.polygon(x, y, 0.5 * size_m, 0.5 * size_m * rng.uniform(0.4, 1.0), angle, a, colour);
   } else if (type == 1) {

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
@@ -74,10 +75,10 @@ Eigen::Matrix3d mujocoToVision() { return Eigen::Vector3d(1.0, -1.0, -1.0).asDia
 }  // namespace
 
 Eigen::Isometry3d cameraInBody(const mjModel* m, int cam_id) {
-  const mjtNum* q = m->cam_quat + 4 * cam_id;
+  const mjtNum* q = m->cam_quat + 4 * static_cast<std::ptrdiff_t>(cam_id);
   Eigen::Isometry3d X_BC = Eigen::Isometry3d::Identity();
   X_BC.linear() = Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix() * mujocoToVision();
-  X_BC.translation() = Eigen::Vector3d(m->cam_pos + 3 * cam_id);
+  X_BC.translation() = Eigen::Vector3d(m->cam_pos + 3 * static_cast<std::ptrdiff_t>(cam_id));
   return X_BC;
 }
 
@@ -88,8 +89,8 @@ Eigen::Isometry3d Camera::pose(const mjData* d) const {
     for (int c = 0; c < 3; ++c) R_W_mj(r, c) = d->cam_xmat[9 * cam_id_ + 3 * r + c];
   }
   X_WC.linear() = R_W_mj * mujocoToVision();
-  X_WC.translation() =
-      Eigen::Vector3d(d->cam_xpos[3 * cam_id_], d->cam_xpos[3 * cam_id_ + 1], d->cam_xpos[3 * cam_id_ + 2]);
+  const mjtNum* p = d->cam_xpos + 3 * static_cast<std::ptrdiff_t>(cam_id_);
+  X_WC.translation() = Eigen::Vector3d(p[0], p[1], p[2]);
   return X_WC;
 }
 

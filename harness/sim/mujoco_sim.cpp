@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
@@ -94,12 +95,13 @@ double vehicleMass(const mjModel* m, const VehicleIds& ids) { return m->body_sub
 control::VehicleParams vehicleParamsFromModel(const mjModel* m, const VehicleIds& ids) {
   control::VehicleParams v;
   v.mass_kg = vehicleMass(m, ids);
-  v.inertia_diag_kg_m2 = Eigen::Vector3d(m->body_inertia + 3 * ids.body);
+  const std::ptrdiff_t body = ids.body;  // pointer offsets below in ptrdiff_t
+  v.inertia_diag_kg_m2 = Eigen::Vector3d(m->body_inertia + 3 * body);
   v.gravity_m_s2 = -m->opt.gravity[2];
-  const Eigen::Vector3d com_B(m->body_ipos + 3 * ids.body);
+  const Eigen::Vector3d com_B(m->body_ipos + 3 * body);
   for (int i = 0; i < 4; ++i) {
-    const int a = ids.motors[i];
-    const int site = m->actuator_trnid[2 * a];
+    const std::ptrdiff_t a = ids.motors[i];
+    const std::ptrdiff_t site = m->actuator_trnid[2 * a];
     if (m->actuator_trntype[a] != mjTRN_SITE || m->site_bodyid[site] != ids.body) {
       throw InputError("actuator 'motor" + std::to_string(i) + "' must act on a site of body 'quadrotor'");
     }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <sstream>
 
@@ -23,8 +24,8 @@ SceneGeometry::SceneGeometry(const mjModel* m, const mjData* d) {
       for (int c = 0; c < 3; ++c) R(r, c) = d->geom_xmat[9 * g + 3 * r + c];
     }
     s.X_WG.linear() = R;
-    s.X_WG.translation() = Eigen::Vector3d(d->geom_xpos + 3 * g);
-    s.size = Eigen::Vector3d(m->geom_size + 3 * g);
+    s.X_WG.translation() = Eigen::Vector3d(d->geom_xpos + 3 * static_cast<std::ptrdiff_t>(g));
+    s.size = Eigen::Vector3d(m->geom_size + 3 * static_cast<std::ptrdiff_t>(g));
     s.rbound = m->geom_rbound[g];
     shapes_.push_back(s);
   }

@@ -201,7 +201,6 @@ TEST(BundleAdjustment, LandmarksObservedOnceArePlacedOnTheirObservation) {
   for (std::size_t j = 0; j < w.problem.X_CW.size(); ++j) {
     EXPECT_TRUE(w.problem.X_CW[j].matrix() == without.problem.X_CW[j].matrix()) << "keyframe " << j;
   }
-  BundleAdjustmentConfig config;
   for (std::size_t i = w.problem.observations.size() - 2; i < w.problem.observations.size(); ++i) {
     const BaObservation& o = w.problem.observations[i];
     const Eigen::Vector3d& p_W = w.problem.p_W[static_cast<std::size_t>(o.landmark)];

@@ -1,0 +1,124 @@
+#!/usr/bin/env bash
+# Sanitizer and fuzzing checks (Clang from Debian; scripts/setup.sh installs it).
+#
+#   scripts/sanitize.sh [check]              AddressSanitizer + UndefinedBehaviorSanitizer build
+#                                            (build-sanitize/): the unit tests, one smoke trial and
+#                                            one smoke sweep, then every fuzz target replayed and
+#                                            fuzzed for FUZZ_SECONDS (default 20) each. CI runs this.
+#   scripts/sanitize.sh fuzz [TARGET...]     build-sanitize/'s fuzz targets for FUZZ_SECONDS each
+#                                            (default 600), all of them or those named.
+#   scripts/sanitize.sh thread               ThreadSanitizer build (build-tsan/) of the pipelined
+#                                            trial's test (three threads: simulation, features, tracking).
+#
+# Only the targets that run are built (-O1 -g1, about 10 minutes on 2 cores). Findings are fatal
+# (-fno-sanitize-recover=all). Suppressions: scripts/sanitize/*.supp, third-party code only.
+# Fuzzing keeps a corpus in build-sanitize/fuzz/corpus/<target> that grows from run to run, and
+# adds each run's seconds and executions to build-sanitize/fuzz/totals.csv; a crash stops it with
+# the input in build-sanitize/fuzz/crashes/<target>/: once fixed, add the input to
+# tests/fuzz/regressions/<target>/, where the replay test keeps it fixed.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+mode=${1:-check}
+[[ $# -gt 0 ]] && shift
+jobs=$(nproc)
+supp="$root/scripts/sanitize"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp"
+export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp"
+
+configure() {  # configure DIR SANITIZERS [cmake args...]
+  local dir=$1 sanitizers=$2
+  shift 2
+  if [[ ! -f "$dir/CMakeCache.txt" ]]; then
+    CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" \
+      -DTGNAV_SANITIZE="$sanitizers" -DTGNAV_BUILD_BENCHMARKS=OFF "$@" >/dev/null
+  fi
+}
+
+fuzz_targets() {  # the list of tests/fuzz/CMakeLists.txt
+  sed -n '/^set(TGNAV_FUZZ_TARGETS/,/)/p' "$root/tests/fuzz/CMakeLists.txt" | sed -e 's/^set(TGNAV_FUZZ_TARGETS//' \
+    -e 's/)//' | tr -s ' ' '\n' | grep -v '^$'
+}
+
+build_fuzz() {  # build_fuzz DIR
+  configure "$1" address,undefined -DTGNAV_FUZZ=ON
+  local targets=(fuzz_seeds)
+  for t in $(fuzz_targets); do targets+=("fuzz_$t"); done
+  cmake --build "$1" -j"$jobs" --target "${targets[@]}"
+}
+
+fuzz() {  # fuzz DIR SECONDS [TARGET...]
+  local dir=$1 seconds=$2
+  shift 2
+  local names=("$@")
+  [[ ${#names[@]} -gt 0 ]] || mapfile -t names < <(fuzz_targets)
+  local work="$dir/fuzz"
+  mkdir -p "$work"
+  "$dir/tests/fuzz/fuzz_seeds" "$work/seeds" >/dev/null
+  [[ -f "$work/totals.csv" ]] || echo "target,seconds,executions,commit" >"$work/totals.csv"
+  local commit
+  commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+  for t in "${names[@]}"; do
+    mkdir -p "$work/corpus/$t" "$work/crashes/$t"
+    local log="$work/$t.log"
+    # -rss_limit_mb: a parser must not need more than this for any input; -timeout: nor this long.
+    if ! "$dir/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 \
+      -artifact_prefix="$work/crashes/$t/" "$work/corpus/$t" "$work/seeds/$t" >"$log" 2>&1; then
+      tail -n 40 "$log" >&2
+      echo "sanitize.sh: fuzz target $t failed; the input is in $work/crashes/$t/ (log: $log)" >&2
+      exit 1
+    fi
+    local execs
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
+    echo "$t,$seconds,${execs:-0},$commit" >>"$work/totals.csv"
+    printf 'fuzz %-15s %4ds %10s executions, corpus %s inputs\n' "$t" "$seconds" "${execs:-0}" \
+      "$(find "$work/corpus/$t" -type f | wc -l)"
+  done
+}
+
+case "$mode" in
+  check)
+    dir="$root/build-sanitize"
+    configure "$dir" address,undefined -DTGNAV_FUZZ=ON -DTGNAV_BUILD_TESTS=ON
+    # The unit tests: every test program but the closed-loop ones on the paper's scenes (minutes
+    # each at sanitizer speed; the smoke trial and sweep below fly the same code).
+    mapfile -t tests < <(cmake --build "$dir" --target help | sed -n 's/^\.\.\. \(test_[a-z_]*\).*/\1/p' |
+      grep -v -E '^test_smoke_|^test_harness_(scene_cache_setup|scene_maps_test|paper_planning_test|scene_trajectory_test|vo_scene_test)$')
+    cmake --build "$dir" -j"$jobs" --target tgnav "${tests[@]}"
+    build_fuzz "$dir"
+    # Left out at sanitizer speed (10-20x slower there, 18 of 27 minutes of test time), each for a
+    # smaller test or the smoke runs below that go through the same code: the property tests over
+    # many random maps (TrajectoryGrid, GridMaps: the other planner tests plan on the same code),
+    # RRT*'s 15000-sample route test, the smoke-map tests (five map builds; the smoke trial below
+    # builds one), and the sweep runner's Slurm and resume tests (the smoke sweep below).
+    slow='TrajectoryGrid\.RandomMaps|GridMaps\.EveryInflatedPath|PerceptionRrtStar\.TakesTheLongerTexturedRoute'
+    slow+='|SmokeMapTest\.|SweepRunner\.(SlurmBackend|LocalRunResumes)'
+    ctest --test-dir "$dir" --output-on-failure -j"$jobs" -E "_NOT_BUILT|^format\\.|^scripts\\.|$slow"
+    smoke=$(mktemp -d)
+    trap 'rm -rf "$smoke"' EXIT
+    "$dir/harness/tgnav" trial --scenario "$root/configs/scenarios/smoke.yaml" --planner proposed --seed 1 \
+      --set camera.width_px=320 --set camera.height_px=240 --map-cache "$smoke/cache" --out "$smoke/trial"
+    printf 'set: {camera.width_px: 320, camera.height_px: 240}\nruns:\n  - {scenario: %s, planner: [proposed, agnostic], seeds: [2]}\n' \
+      "$root/configs/scenarios/smoke.yaml" >"$smoke/sweep.yaml"
+    "$dir/harness/tgnav" sweep --sweep "$smoke/sweep.yaml" --jobs "$jobs" --map-cache "$smoke/cache" --out "$smoke/sweep"
+    "$dir/harness/tgnav" report "$smoke/sweep" --out "$smoke/report" >/dev/null
+    fuzz "$dir" "${FUZZ_SECONDS:-20}"
+    echo "sanitize.sh: address,undefined clean: unit tests, smoke trial, smoke sweep and report, $(fuzz_targets | wc -l) fuzz targets"
+    ;;
+  fuzz)
+    build_fuzz "$root/build-sanitize"
+    fuzz "$root/build-sanitize" "${FUZZ_SECONDS:-600}" "$@"
+    ;;
+  thread)
+    dir="$root/build-tsan"
+    configure "$dir" thread -DTGNAV_BUILD_TESTS=ON
+    cmake --build "$dir" -j"$jobs" --target tgnav test_smoke_trial_test
+    "$dir/tests/smoke/test_smoke_trial_test" --gtest_filter='SmokeTrial.SameSeedSameMetricsPipelinedOrNot'
+    echo "sanitize.sh: thread clean: the pipelined trial"
+    ;;
+  *)
+    echo "usage: scripts/sanitize.sh [check | fuzz [TARGET...] | thread]" >&2
+    exit 2
+    ;;
+esac
