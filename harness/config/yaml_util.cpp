@@ -25,6 +25,25 @@ YAML::Node exactSequence(const double* values, std::size_t count) {
   return seq;
 }
 
+namespace {
+// Every mapping key in `node` is a plain scalar: yaml-cpp compares keys as strings when a key is
+// looked up, and a key that is itself a mapping or a list ("{}: 1", found by fuzzing) would throw
+// its own exception there instead of an error naming the file.
+void checkScalarKeys(const YAML::Node& node, const std::filesystem::path& file) {
+  if (node.IsMap()) {
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) {
+        throw InputError(file.string() + ":" + std::to_string(kv.first.Mark().line + 1) +
+                         ": a mapping key must be a plain name, not a mapping or a list");
+      }
+      checkScalarKeys(kv.second, file);
+    }
+  } else if (node.IsSequence()) {
+    for (const auto& item : node) checkScalarKeys(item, file);
+  }
+}
+}  // namespace
+
 YamlDoc YamlDoc::load(const std::filesystem::path& file) {
   YamlDoc doc;
   doc.file_ = file;
@@ -36,6 +55,7 @@ YamlDoc YamlDoc::load(const std::filesystem::path& file) {
     throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
   if (!doc.root_.IsMap()) throw InputError(file.string() + ": expected a mapping of keys at top level");
+  checkScalarKeys(doc.root_, file);
   return doc;
 }
 
