@@ -120,123 +120,94 @@ Outcome textParser(const Body& body, const std::string& input) {
 
 struct Entry {
   Target target;
-  std::function<Outcome(const std::string&)> run;
+  Outcome (*contract)(const Body&, const std::string&);  // harnessParser or textParser
+  Body parse;                                            // writes the input where it goes and parses it
 };
 
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> all = {
-      {{"tum", "a TUM trajectory (vo::parseTum)"},
-       [](const std::string& in) { return textParser([](const std::string& t) { vo::parseTum(t); }, in); }},
-      {{"kitti", "a KITTI trajectory (vo::parseKitti)"},
-       [](const std::string& in) { return textParser([](const std::string& t) { vo::parseKitti(t); }, in); }},
-      {{"euroc", "a EuRoC trajectory (vo::parseEuroc)"},
-       [](const std::string& in) { return textParser([](const std::string& t) { vo::parseEuroc(t); }, in); }},
+      {{"tum", "a TUM trajectory (vo::parseTum)"}, textParser, [](const std::string& t) { vo::parseTum(t); }},
+      {{"kitti", "a KITTI trajectory (vo::parseKitti)"}, textParser, [](const std::string& t) { vo::parseKitti(t); }},
+      {{"euroc", "a EuRoC trajectory (vo::parseEuroc)"}, textParser, [](const std::string& t) { vo::parseEuroc(t); }},
       {{"trajectory_csv", "a setpoint trajectory CSV (tgnav fly --trajectory)"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path file = scratch().fresh() / "trajectory.csv";
-               write(file, t);
-               harness::readTrajectoryCsv(file);
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path file = scratch().fresh() / "trajectory.csv";
+         write(file, t);
+         harness::readTrajectoryCsv(file);
        }},
       {{"movingai_map", "a MovingAI .map"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path file = scratch().fresh() / "grid.map";
-               write(file, t);
-               harness::loadMovingAiMap(file, 0.5);
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path file = scratch().fresh() / "grid.map";
+         write(file, t);
+         harness::loadMovingAiMap(file, 0.5);
        }},
       {{"movingai_scen", "a MovingAI .scen, checked against a 64x64 map"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path file = scratch().fresh() / "grid.map.scen";
-               write(file, t);
-               const auto rows = harness::loadMovingAiScen(file);
-               harness::checkScenAgainstMap(file, rows, 64, 64);
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path file = scratch().fresh() / "grid.map.scen";
+         write(file, t);
+         const auto rows = harness::loadMovingAiScen(file);
+         harness::checkScenAgainstMap(file, rows, 64, 64);
        }},
       {{"ros_map", "sections: map_server YAML, then the PGM it may name as map.pgm"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const auto parts = sections(t, 2);
-               const fs::path run = scratch().fresh();
-               writeSection(parts, 0, run / "map.yaml");
-               writeSection(parts, 1, run / "map.pgm");
-               harness::loadRosMap(run / "map.yaml");
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const auto parts = sections(t, 2);
+         const fs::path run = scratch().fresh();
+         writeSection(parts, 0, run / "map.yaml");
+         writeSection(parts, 1, run / "map.pgm");
+         harness::loadRosMap(run / "map.yaml");
        }},
       {{"tum_rgbd", "sections: rgb.txt, depth.txt, groundtruth.txt, intrinsics.yaml (images rgb|depth/0..2.png exist)"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const auto parts = sections(t, 4);
-               const fs::path seq = scratch().fresh() / "seq";
-               for (const char* sub : {"rgb", "depth"}) {
-                 for (int i = 0; i < 3; ++i) write(seq / sub / (std::to_string(i) + ".png"), "");
-               }
-               writeSection(parts, 0, seq / "rgb.txt");
-               writeSection(parts, 1, seq / "depth.txt");
-               writeSection(parts, 2, seq / "groundtruth.txt");
-               writeSection(parts, 3, seq / "intrinsics.yaml");
-               harness::loadSequence(seq);
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const auto parts = sections(t, 4);
+         const fs::path seq = scratch().fresh() / "seq";
+         for (const char* sub : {"rgb", "depth"}) {
+           for (int i = 0; i < 3; ++i) write(seq / sub / (std::to_string(i) + ".png"), "");
+         }
+         writeSection(parts, 0, seq / "rgb.txt");
+         writeSection(parts, 1, seq / "depth.txt");
+         writeSection(parts, 2, seq / "groundtruth.txt");
+         writeSection(parts, 3, seq / "intrinsics.yaml");
+         harness::loadSequence(seq);
        }},
       {{"intrinsics", "a TUM RGB-D sequence's intrinsics.yaml (with valid image lists)"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path seq = scratch().fresh() / "seq";
-               write(seq / "rgb" / "0.png", "");
-               write(seq / "depth" / "0.png", "");
-               write(seq / "rgb.txt", "# rgb\n0.000000 rgb/0.png\n");
-               write(seq / "depth.txt", "# depth\n0.000000 depth/0.png\n");
-               write(seq / "intrinsics.yaml", t);
-               harness::loadSequence(seq);
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path seq = scratch().fresh() / "seq";
+         write(seq / "rgb" / "0.png", "");
+         write(seq / "depth" / "0.png", "");
+         write(seq / "rgb.txt", "# rgb\n0.000000 rgb/0.png\n");
+         write(seq / "depth.txt", "# depth\n0.000000 depth/0.png\n");
+         write(seq / "intrinsics.yaml", t);
+         harness::loadSequence(seq);
        }},
       {{"scene", "a scene YAML (its mjcf may name ../fuzz.xml)"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path run = configLayout({t}, {"scenes"});
-               harness::loadSceneConfig(run / "scenes" / "fuzz.yaml");
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path run = configLayout({t}, {"scenes"});
+         harness::loadSceneConfig(run / "scenes" / "fuzz.yaml");
        }},
       {{"scenario", "sections: scenario YAML, scene YAML (../scenes/fuzz.yaml), --set assignments one per line"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const auto parts = sections(t, 3);
-               const fs::path run = configLayout(parts, {"scenarios", "scenes"});
-               if (parts.size() > 2) {
-                 const harness::YamlDoc overrides = harness::YamlDoc::fromOverrides(lines(parts[2]));
-                 harness::loadScenario(run / "scenarios" / "fuzz.yaml", &overrides);
-               } else {
-                 harness::loadScenario(run / "scenarios" / "fuzz.yaml");
-               }
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const auto parts = sections(t, 3);
+         const fs::path run = configLayout(parts, {"scenarios", "scenes"});
+         if (parts.size() > 2) {
+           const harness::YamlDoc overrides = harness::YamlDoc::fromOverrides(lines(parts[2]));
+           harness::loadScenario(run / "scenarios" / "fuzz.yaml", &overrides);
+         } else {
+           harness::loadScenario(run / "scenarios" / "fuzz.yaml");
+         }
        }},
       {{"sweep", "sections: sweep YAML, scenario YAML (../scenarios/fuzz.yaml), scene YAML"},
-       [](const std::string& in) {
-         return harnessParser(
-             [](const std::string& t) {
-               const fs::path run = configLayout(sections(t, 3), {"sweeps", "scenarios", "scenes"});
-               harness::loadSweep(run / "sweeps" / "fuzz.yaml", run / "generated");
-             },
-             in);
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path run = configLayout(sections(t, 3), {"sweeps", "scenarios", "scenes"});
+         harness::loadSweep(run / "sweeps" / "fuzz.yaml", run / "generated");
        }},
   };
   return all;
@@ -322,7 +293,7 @@ Outcome run(const std::string& name, const std::uint8_t* data, std::size_t size,
   for (const Entry& e : entries()) {
     if (e.target.name != name) continue;
     lastError().clear();
-    const Outcome outcome = e.run(std::string(reinterpret_cast<const char*>(data), size));
+    const Outcome outcome = e.contract(e.parse, std::string(reinterpret_cast<const char*>(data), size));
     if (why != nullptr) *why = lastError();
     return outcome;
   }
