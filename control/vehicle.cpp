@@ -1,5 +1,8 @@
 #include "control/vehicle.h"
 
+#include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -23,6 +26,34 @@ void VehicleParams::validate() const {
   if (!(motor_time_constant_s >= 0.0)) fail("motor_time_constant_s: must be >= 0");
   if (!(gravity_m_s2 > 0.0)) fail("gravity_m_s2: must be > 0");
   require(hoverThrust() < 0.9, "hover thrust (of maximum)", hoverThrust(), "vehicle too heavy to fly");
+}
+
+Eigen::MatrixXd VehicleParams::effectivenessPerNewton() const {
+  Eigen::MatrixXd e(4, static_cast<Eigen::Index>(rotors.size()));
+  for (std::size_t i = 0; i < rotors.size(); ++i) {
+    const Rotor& r = rotors[i];
+    // Thrust moment p x F, plus the rotor drag reaction (-spin along the axis).
+    const Eigen::Vector3d moment = r.p_B.cross(r.axis_B) - r.spin * r.yaw_moment_ratio_m * r.axis_B;
+    e.col(static_cast<Eigen::Index>(i)) << moment, r.axis_B.z();
+  }
+  return e;
+}
+
+void VehicleParams::checkControllable() const {
+  for (std::size_t i = 0; i < rotors.size(); ++i) {
+    if (!(rotors[i].axis_B.z() > 0.0)) {
+      throw std::invalid_argument("rotors[" + std::to_string(i) + "].axis_B: thrust must point upward (z > 0)");
+    }
+  }
+  const Eigen::MatrixXd e = effectivenessPerNewton();
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(e);
+  qr.setThreshold(1e-6);
+  if (qr.rank() < 4) {
+    throw std::invalid_argument(
+        "rotors: the rotor geometry cannot command roll, pitch, yaw and thrust "
+        "independently (effectiveness matrix rank " +
+        std::to_string(qr.rank()) + " < 4: check the rotor sites and the spin signs of the gears)");
+  }
 }
 
 double VehicleParams::totalMaxThrustN() const {

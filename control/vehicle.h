@@ -22,6 +22,11 @@ struct VehicleParams {
 
   // Throws std::invalid_argument naming the field and value.
   void validate() const;
+  // Throws std::invalid_argument unless the rotors can command roll, pitch and yaw moments and
+  // collective thrust independently (the effectiveness matrix has rank 4) and every rotor lifts.
+  void checkControllable() const;
+  // The 4 x n wrench [Mx, My, Mz, Fz] per newton of each rotor's thrust.
+  Eigen::MatrixXd effectivenessPerNewton() const;
   double totalMaxThrustN() const;
   // Normalised collective thrust that balances gravity when level.
   double hoverThrust() const;

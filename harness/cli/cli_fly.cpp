@@ -17,7 +17,11 @@ void addFlyCommand(CLI::App& app) {
                   "CSV with header: t,x,y,z,yaw[,vx,vy,vz][,ax,ay,az][,yaw_rate] (s, m, rad)")
       ->required();
   cmd->add_option("--out", opt->out, "Output directory")->required();
-  cmd->add_option("--controller", opt->controller, "Controller YAML (default: built-in, see configs/controller.yaml)");
+  cmd->add_option("--vehicle", opt->vehicle,
+                  "Vehicle description YAML (default: the scene's, e.g. models/quadrotor.yaml; see models/vehicles/)");
+  cmd->add_option("--controller", opt->controller,
+                  "Controller YAML over the vehicle's gains (default: the vehicle's gains file, else the built-in "
+                  "defaults of configs/controller.yaml)");
   CLI::Option* record = cmd->add_option(
       "--record", opt->record,
       "Record the onboard RGB-D camera into this new directory as a TUM RGB-D sequence (ground truth included)");

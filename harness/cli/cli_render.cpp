@@ -14,6 +14,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--scene", opt->scene, "Scene YAML (configs/scenes/*.yaml) or MJCF file")->required();
   cmd->add_option("--pose", opt->pose, "Vehicle pose x,y,z,yaw in metres and radians (default: the scene's start)");
   cmd->add_option("--out", opt->out, "Output directory")->required();
+  cmd->add_option("--vehicle", opt->vehicle, "Vehicle description YAML whose camera renders (default: the scene's)");
   cmd->add_option("--camera-config", opt->camera_config, "Camera YAML (default: built-in, see configs/camera.yaml)");
   cmd->add_option("--width", size->first, "Image width in pixels (overrides the camera config)");
   cmd->add_option("--height", size->second, "Image height in pixels (overrides the camera config)");

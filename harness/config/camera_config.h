@@ -5,8 +5,11 @@
 
 namespace tgnav::harness {
 
+// The camera name that stands for the camera the vehicle description names.
+inline constexpr const char* kVehicleCamera = "vehicle";
+
 struct CameraConfig {
-  std::string name = "front";  // MJCF camera name
+  std::string name = kVehicleCamera;  // MJCF camera name, or "vehicle": the vehicle's camera
   int width_px = 640;
   int height_px = 480;
   double near_clip_m = 0.05;  // OpenGL clipping planes
@@ -37,6 +40,16 @@ struct CameraConfig {
 
   // Throws std::invalid_argument naming the field and value.
   void validate() const;
+  // The MJCF camera this config renders from: `name`, or `vehicle_camera` for "vehicle".
+  std::string cameraName(const std::string& vehicle_camera) const {
+    return name == kVehicleCamera ? vehicle_camera : name;
+  }
+  // This config with cameraName() as its name.
+  CameraConfig on(const std::string& vehicle_camera) const {
+    CameraConfig c = *this;
+    c.name = cameraName(vehicle_camera);
+    return c;
+  }
 };
 
 }  // namespace tgnav::harness

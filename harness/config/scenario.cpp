@@ -5,6 +5,7 @@
 
 #include "harness/base/errors.h"
 #include "harness/config/config_io.h"
+#include "harness/config/vehicle_config.h"
 
 namespace tgnav::harness {
 
@@ -91,7 +92,9 @@ template <typename Config>
 void readSection(const YamlDoc& doc, const YamlDoc* overrides, const std::string& key, Config* c) {
   const YAML::Node& root = doc.root();
   const std::string file_key = fileKey(key);
-  if (root[file_key]) *c = loadConfigFile(relativeFile(doc, file_key), Config{});
+  // The file goes over what the section holds already: the built-in defaults, or for the
+  // controller the vehicle's gains.
+  if (root[file_key]) *c = loadConfigFile(relativeFile(doc, file_key), *c);
   if (root[key]) readConfig(YamlArchive(doc, root[key], key), c);
   const bool overridden = overrides && overrides->root()[key];
   if (overridden) readConfig(YamlArchive(*overrides, overrides->root()[key], key), c);
@@ -131,7 +134,7 @@ YAML::Node poseYaml(const planner::Pose4& pose) {
 
 Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
   const YamlDoc doc = YamlDoc::load(yaml);
-  std::vector<std::string> keys = {"scene", "seed", "start", "goal"};
+  std::vector<std::string> keys = {"scene", "vehicle", "seed", "start", "goal"};
   std::vector<std::string> override_keys = keys;
   for (const std::string& section : sectionKeys()) {
     keys.insert(keys.end(), {fileKey(section), section});
@@ -156,6 +159,11 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
   s.seed = readSeed(sourceOf(doc, overrides, "seed"));
   readPoseOverride(sourceOf(doc, overrides, "start"), "start", s.scene, &s.scene.start);
   readPoseOverride(sourceOf(doc, overrides, "goal"), "goal", s.scene, &s.scene.goal);
+  const YamlDoc& vehicle_doc = sourceOf(doc, overrides, "vehicle");
+  const fs::path named = vehicle_doc.root()["vehicle"] ? relativeFile(vehicle_doc, "vehicle") : s.scene.vehicle;
+  s.vehicle = resolveVehicle(s.scene.mjcf, named);
+  const VehicleDescription vehicle = loadVehicleDescription(s.vehicle);
+  if (!vehicle.controller_config.empty()) s.controller = loadCascadeConfig(vehicle.controller_config);
 
   SectionReader sections(doc, overrides);
   s.visitSections(sections);
@@ -165,6 +173,7 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
 std::string resolvedScenarioYaml(const Scenario& s) {
   YAML::Node root(YAML::NodeType::Map);
   root["scene"] = fs::absolute(s.scene.source).lexically_normal().string();
+  root["vehicle"] = fs::absolute(s.vehicle).lexically_normal().string();
   root["seed"] = std::to_string(s.seed);
   root["start"] = poseYaml(s.scene.start);
   root["goal"] = poseYaml(s.scene.goal);

@@ -8,6 +8,7 @@
 //   seed: 1                              # required, >= 0
 //   start: [x, y, z, yaw]                # optional, replaces the scene's
 //   goal: [x, y, z, yaw]                 # optional
+//   vehicle: ../../models/vehicles/hexarotor.yaml  # optional: flies the scene in place of its own
 //   planner_config: ../planner.yaml      # optional files (all keys optional) ...
 //   controller_config: ../controller.yaml
 //   camera_config: ../camera.yaml
@@ -19,9 +20,13 @@
 //   vo: {min_inliers: 20}
 //   trial: {state_source: vo}
 //
-// Overrides (`--set KEY=VALUE`, YamlDoc::fromOverrides) may set scene (a path relative to the
-// current directory), seed, start, goal and the keys of planner, controller, camera, vo and trial;
-// not the *_config files.
+// Overrides (`--set KEY=VALUE`, YamlDoc::fromOverrides) may set scene and vehicle (paths relative
+// to the current directory), seed, start, goal and the keys of planner, controller, camera, vo and
+// trial; not the *_config files.
+//
+// The controller's layers begin with the vehicle's gains file (its description's
+// `controller_config`), over the built-in defaults: defaults < vehicle gains < controller_config <
+// controller < --set.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -39,6 +44,9 @@ namespace tgnav::harness {
 struct Scenario {
   std::filesystem::path source;
   SceneConfig scene;  // start and goal are the scenario's (the scene's unless it replaced them)
+  // The vehicle description that flies (absolute): the scenario's `vehicle`, else the scene's,
+  // else that of the vehicle the scene's MJCF includes.
+  std::filesystem::path vehicle;
   std::uint64_t seed = 0;
   PlannerSettings planner;
   control::CascadeConfig controller;

@@ -1,6 +1,7 @@
 #include "harness/config/scene_config.h"
 
 #include "harness/base/errors.h"
+#include "harness/config/vehicle_config.h"
 #include "harness/config/yaml_util.h"
 
 namespace tgnav::harness {
@@ -9,12 +10,21 @@ SceneConfig loadSceneConfig(const std::filesystem::path& yaml) {
   const YamlDoc doc = YamlDoc::load(yaml);
   const YAML::Node& root = doc.root();
   SceneConfig scene;
-  YamlArchive(doc, root, "").required().fields(scene);
+  YamlArchive(doc, root, "").required().except({"vehicle"}).fields(scene);
   scene.source = yaml;
   const std::string mjcf = scene.mjcf.string();
   scene.mjcf = std::filesystem::absolute(yaml.parent_path() / mjcf).lexically_normal();
   if (!std::filesystem::is_regular_file(scene.mjcf)) {
     doc.fail(root["mjcf"], "key 'mjcf' has value '" + mjcf + "': file " + scene.mjcf.string() + " not found");
+  }
+  if (!scene.vehicle.empty()) {
+    const std::string text = scene.vehicle.string();
+    scene.vehicle = std::filesystem::absolute(yaml.parent_path() / text).lexically_normal();
+    if (!std::filesystem::is_regular_file(scene.vehicle)) {
+      doc.fail(root["vehicle"],
+               "key 'vehicle' has value '" + text + "': file " + scene.vehicle.string() + " not found");
+    }
+    loadVehicleDescription(scene.vehicle);  // its own errors name its file
   }
   if ((scene.bounds_max_m.array() <= scene.bounds_min_m.array()).any()) {
     doc.fail(root["bounds"], "key 'bounds.max' must exceed 'bounds.min' on every axis");

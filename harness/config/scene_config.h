@@ -37,8 +37,11 @@ struct SceneConfig {
   Eigen::Vector3d bounds_min_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d bounds_max_m = Eigen::Vector3d::Zero();
   SurveyPlan survey;
+  // The vehicle description (harness/config/vehicle_config.h) that flies the scene unless a
+  // scenario names another; absolute. Empty: the vehicle the MJCF includes.
+  std::filesystem::path vehicle;
 
-  // The keys of a scene file, all required (harness/config/yaml_util.h); `source` has none.
+  // The keys of a scene file, all required but `vehicle` (harness/config/yaml_util.h); `source` has none.
   template <typename Archive>
   void visit(Archive& a) {
     a("mjcf", mjcf);  // in the file: relative to it
@@ -50,13 +53,15 @@ struct SceneConfig {
       g("max", bounds_max_m);
     });
     a("survey", survey);
+    a("vehicle", vehicle);  // in the file: relative to it
   }
 };
 
 // Loads configs/scenes/<name>.yaml (strict keys, all required; `mjcf` relative to the YAML file),
 // then checks that the MJCF exists, bounds.max > bounds.min, the start, the goal, the flight
 // height and the survey heights lie inside the bounds, survey.heights_m is not empty,
-// survey.spacing_m >= 0.1, survey.clearance_m >= 0 and survey.yaw_count is in [1, 64].
+// survey.spacing_m >= 0.1, survey.clearance_m >= 0 and survey.yaw_count is in [1, 64], and that
+// the optional `vehicle` (relative to the YAML file) is a vehicle description.
 SceneConfig loadSceneConfig(const std::filesystem::path& yaml);
 
 // `path` may be a scene YAML or a bare MJCF file (.xml: only `mjcf` and `source` are set).

@@ -1,5 +1,6 @@
 #include "harness/config/yaml_util.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -273,7 +274,7 @@ YAML::Node YamlArchive::present(const std::string& key) {
   known_.push_back(key);
   if (writing()) return YAML::Node();
   YAML::Node node = map_[key];
-  if (!node && required_) missing(key);
+  if (!node && required_ && std::find(optional_.begin(), optional_.end(), key) == optional_.end()) missing(key);
   return node;
 }
 

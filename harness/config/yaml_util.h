@@ -248,6 +248,11 @@ class YamlArchive {
     required_ = true;
     return *this;
   }
+  // Reading with required(): these keys of this archive's own mapping stay optional.
+  YamlArchive& except(std::vector<std::string> optional_keys) {
+    optional_ = std::move(optional_keys);
+    return *this;
+  }
 
   // One field.
   YamlArchive& operator()(const std::string& key, double& field);
@@ -349,6 +354,7 @@ class YamlArchive {
   YAML::Node map_;
   std::string context_;
   bool required_ = false;
+  std::vector<std::string> optional_;  // exempt from required_
   std::vector<std::string> known_;
 };
 

@@ -101,13 +101,23 @@ void checkSettingKey(const YamlDoc& doc, const YAML::Node& key_node, const std::
   }
 }
 
+// A value as `--set` takes it; a `vehicle` (a file) made absolute from the sweep file's folder,
+// as the runs' scenarios are, so that it means the same wherever the trials run.
+std::string settingValue(const YamlDoc& doc, const std::string& key, const YAML::Node& value) {
+  const std::string text = valueText(value);
+  if (key != "vehicle") return text;
+  const fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
+  if (!fs::is_regular_file(p)) doc.fail(value, "vehicle: file " + p.string() + " not found");
+  return p.string();
+}
+
 void readAssignments(const YamlDoc& doc, const YAML::Node& map, const std::string& context, Assignments* out) {
   if (const YAML::Node set = map["set"]) {
     if (!set.IsMap()) doc.fail(set, joinKey(context, "set") + ": expected a mapping of config keys to values");
     for (const auto& kv : set) {
       checkSettingKey(doc, kv.first, joinKey(context, "set"));
       if (kv.second.IsNull()) doc.fail(kv.first, joinKey(context, "set." + kv.first.Scalar()) + ": no value");
-      out->fixed.emplace_back(kv.first.Scalar(), valueText(kv.second));
+      out->fixed.emplace_back(kv.first.Scalar(), settingValue(doc, kv.first.Scalar(), kv.second));
     }
   }
   if (const YAML::Node axes = map["axes"]) {
@@ -119,7 +129,7 @@ void readAssignments(const YamlDoc& doc, const YAML::Node& map, const std::strin
         doc.fail(kv.first, joinKey(context, "axes." + key) + ": expected a non-empty list of values");
       }
       std::vector<std::string> values;
-      for (const YAML::Node& v : kv.second) values.push_back(valueText(v));
+      for (const YAML::Node& v : kv.second) values.push_back(settingValue(doc, key, v));
       out->axes.emplace_back(key, values);
     }
   }
@@ -139,7 +149,10 @@ std::string trialId(const SweepTrial& t, std::size_t seed_width) {
   if (t.planner == "rrtstar") id += "-" + std::to_string(t.samples);
   std::stringstream params(t.params);
   std::string item;
-  while (std::getline(params, item, ';')) id += "__" + sanitise(item);
+  while (std::getline(params, item, ';')) {
+    if (item.rfind("vehicle=", 0) == 0) item = "vehicle=" + fs::path(item.substr(8)).stem().string();  // its name
+    id += "__" + sanitise(item);
+  }
   std::string seed = std::to_string(t.seed);
   if (seed.size() < seed_width) seed.insert(0, seed_width - seed.size(), '0');
   return id + "__s" + seed;

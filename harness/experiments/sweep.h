@@ -14,6 +14,7 @@
 //       samples: [300, 1000, 2000]               # rrtstar's sample budget (rrtstar only)
 //       set: {vo.min_inliers: 25}                # optional: fixed overrides of this run
 //       axes: {vo.max_features: [300, 600]}      # optional: any config key, one value each
+//                                                # (a `vehicle` file relative to this file)
 //     - generated: {kind: room, seeds: [101, 102]}  # instead of scenario: generated scenes, written
 //       planner: proposed                           # into DIR/scenes/ (harness/experiments/sweep_scenes.h)
 //

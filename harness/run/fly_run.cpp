@@ -16,6 +16,7 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/flight_loop.h"
+#include "harness/sim/vehicle_model.h"
 #include "vo/tum.h"
 
 namespace tgnav::harness {
@@ -28,9 +29,10 @@ struct RecordPlan {
   int steps_per_frame = 0;
 };
 
-RecordPlan planRecording(const FlyJob& opt, const mjModel* model) {
+RecordPlan planRecording(const FlyJob& opt, const mjModel* model, const std::string& vehicle_camera) {
   RecordPlan plan;
   if (!opt.camera_config.empty()) plan.camera = loadCameraConfig(opt.camera_config);
+  plan.camera = plan.camera.on(vehicle_camera);
   if (opt.width_px) plan.camera.width_px = *opt.width_px;
   if (opt.height_px) plan.camera.height_px = *opt.height_px;
   try {
@@ -136,14 +138,15 @@ class Recorder {
 };
 
 // The landed pose: the scene's start, or for a bare MJCF below the first setpoint at z = 0.
-planner::Pose4 landedPose(const SceneConfig& scene, const control::SetpointTrajectory& traj, const FlyJob& job) {
+planner::Pose4 landedPose(const SceneConfig& scene, const control::SetpointTrajectory& traj, const FlyJob& job,
+                          double landed_height_m) {
   planner::Pose4 landed = scene.start;
   if (scene.source != scene.mjcf) {
     checkAgainstScene(scene, traj, FlightConfig{}, job.trajectory.string());
-    landed.p_WB.z() = scene.bounds_min_m.z() + kLandedHeightM;
+    landed.p_WB.z() = scene.bounds_min_m.z() + landed_height_m;
   } else {
     landed.p_WB = traj.setpoints().front().p_WB;
-    landed.p_WB.z() = kLandedHeightM;
+    landed.p_WB.z() = landed_height_m;
     landed.yaw_rad = traj.setpoints().front().yaw_rad;
   }
   return landed;
@@ -197,16 +200,21 @@ nlohmann::ordered_json trackingJson(const FlyJob& job, const FlightResult& resul
 FlyRunResult runFly(const FlyJob& job) {
   const SceneConfig scene = loadScene(job.scene);
   const control::SetpointTrajectory traj = readTrajectoryCsv(job.trajectory);
+  VehicleModel vehicle = loadVehicleModel(scene.mjcf, job.vehicle.empty() ? scene.vehicle : job.vehicle);
+  // Gains: built-in defaults < the vehicle's gains file < --controller.
   control::CascadeConfig cascade_config;
-  if (!job.controller.empty()) cascade_config = loadCascadeConfig(job.controller);
+  if (!vehicle.vehicle.controller_config.empty()) {
+    cascade_config = loadCascadeConfig(vehicle.vehicle.controller_config);
+  }
+  if (!job.controller.empty()) cascade_config = loadCascadeConfig(job.controller, cascade_config);
 
-  ModelPtr model = loadModel(scene.mjcf);
+  ModelPtr model = std::move(vehicle.model);
   DataPtr data = makeData(model.get());
-  const auto ids = VehicleIds::find(model.get(), scene.mjcf.string());
-  setVehiclePose(model.get(), data.get(), ids, landedPose(scene, traj, job));
+  const VehicleIds& ids = vehicle.ids;
+  setVehiclePose(model.get(), data.get(), ids, landedPose(scene, traj, job, ids.landed_height_m));
   FlightLoop loop(model.get(), data.get(), ids, cascade_config);
   const bool recording = !job.record.empty();
-  const RecordPlan plan = recording ? planRecording(job, model.get()) : RecordPlan{};
+  const RecordPlan plan = recording ? planRecording(job, model.get(), vehicle.vehicle.camera) : RecordPlan{};
   std::unique_ptr<Recorder> recorder;
   FlightHooks hooks;
   if (recording) {
@@ -236,8 +244,8 @@ FlyRunResult runFly(const FlyJob& job) {
     out.tracking["record"]["dir"] = recorder->dir().string();
   }
 
-  const int cam_id = mj_name2id(model.get(), mjOBJ_CAMERA, "front");
-  const Eigen::Isometry3d X_BC = cam_id >= 0 ? cameraInBody(model.get(), cam_id) : Eigen::Isometry3d::Identity();
+  const int cam_id = recording ? mj_name2id(model.get(), mjOBJ_CAMERA, plan.camera.name.c_str()) : ids.camera;
+  const Eigen::Isometry3d X_BC = cameraInBody(model.get(), cam_id);
   StagedDir staged(job.out);
   writeFileAtomic(staged.staging() / "gt.tum", vo::toTum(cameraPoses(result, X_BC)));
   writeFileAtomic(staged.staging() / "flight.csv", flightCsv(result));

@@ -15,7 +15,11 @@ struct FlyJob {
   std::filesystem::path scene;       // scene YAML, or an MJCF that includes the vehicle
   std::filesystem::path trajectory;  // CSV (harness/io/trajectory_csv.h)
   std::filesystem::path out;
-  std::string controller;  // controller YAML; "" = built-in
+  // Vehicle description; empty: the scene's (its `vehicle`, else the vehicle its MJCF includes).
+  std::filesystem::path vehicle;
+  // Controller YAML over the vehicle's gains (its description's controller_config, else the
+  // built-in defaults); "" = none.
+  std::string controller;
   // Recording of the onboard camera (empty record: none).
   std::string record;
   double record_rate_hz = 20.0;

@@ -13,14 +13,16 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
+#include "harness/sim/vehicle_model.h"
 
 namespace tgnav::harness {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-// Rotor tips of models/quadrotor.xml: 0.25 m arm + 0.12 m propeller, rounded down: the start
-// and goal must leave at least this much room.
+// Rotor tips of models/quadrotor.xml (0.25 m arm + 0.12 m propeller), rounded down: the start
+// and goal of a scene must leave at least this much room (a property of the scene, checked the
+// same whatever vehicle flies it).
 constexpr double kVehicleRadiusM = 0.3;
 // Survey frames rendered ahead of their integration (bounds the memory of a fast renderer).
 constexpr std::size_t kSurveyQueueFrames = 4;
@@ -210,16 +212,19 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   config.validate();
   const auto t_start = Clock::now();
   MapBuildStats stats;
-  ModelPtr model = loadModel(scene.mjcf);
+  // The scene's own vehicle carries the survey camera, whatever vehicle a scenario flies: the
+  // map is of the scene.
+  VehicleModel vehicle = loadVehicleModel(scene.mjcf, scene.vehicle);
+  ModelPtr model = std::move(vehicle.model);
   DataPtr data = makeData(model.get());
   mj_forward(model.get(), data.get());
   const SceneGeometry geometry(model.get(), data.get());
   checkStartGoalFree(scene, geometry, kVehicleRadiusM);
   const std::vector<planner::Pose4> poses = surveyPoses(scene, geometry);
   stats.survey_positions = static_cast<int>(poses.size()) / scene.survey.yaw_count;
-  const VehicleIds ids = VehicleIds::find(model.get(), scene.mjcf.string());
+  const VehicleIds& ids = vehicle.ids;
   EglContext gl;
-  Camera camera(model.get(), gl, config.camera, 0);
+  Camera camera(model.get(), gl, config.camera.on(vehicle.vehicle.camera), 0);
   const Intrinsics& k = camera.intrinsics();
   const vo::FeatureDetector detector(config.features);
   planner::FeatureMap map(config.resolution_m);

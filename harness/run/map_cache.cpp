@@ -13,6 +13,7 @@
 #include "harness/base/quiet_stderr.h"
 #include "harness/io/staged_output.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 
 namespace tgnav::harness {
 
@@ -72,10 +73,15 @@ std::filesystem::path defaultCacheDir() {
 }
 
 std::string mapKey(const SceneConfig& scene, const MapBuildConfig& config) {
+  // The scene's own vehicle carries the survey camera (harness/run/map_builder.cpp); a scenario's
+  // choice of vehicle does not enter the key.
+  const VehicleModel vehicle = loadVehicleModel(scene.mjcf, scene.vehicle);
+  MapBuildConfig resolved = config;
+  resolved.camera = config.camera.on(vehicle.vehicle.camera);
   Fnv1a h;
-  h.add(settingsText(scene, config));
+  h.add(settingsText(scene, resolved));
   // The compiled model holds the geometry, materials and decoded textures: what the camera sees.
-  const ModelPtr model = loadModel(scene.mjcf);
+  const ModelPtr& model = vehicle.model;
   std::vector<unsigned char> bytes(static_cast<std::size_t>(mj_sizeModel(model.get())));
   mj_saveModel(model.get(), nullptr, bytes.data(), static_cast<int>(bytes.size()));
   h.add(bytes.data(), bytes.size());

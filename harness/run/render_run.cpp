@@ -15,6 +15,7 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 
 namespace tgnav::harness {
 
@@ -66,10 +67,11 @@ YAML::Node poseAndRenderer(const std::string& scene, const Eigen::Isometry3d& X_
 std::string runRender(const RenderJob& job) {
   const SceneConfig scene = loadScene(job.scene);
   const planner::Pose4 pose = renderPose(job, scene);
-  const CameraConfig camera_config = renderCamera(job);
-  ModelPtr model = loadModel(scene.mjcf);
+  VehicleModel vehicle = loadVehicleModel(scene.mjcf, job.vehicle.empty() ? scene.vehicle : job.vehicle);
+  const CameraConfig camera_config = renderCamera(job).on(vehicle.vehicle.camera);
+  ModelPtr model = std::move(vehicle.model);
   DataPtr data = makeData(model.get());
-  setVehiclePose(model.get(), data.get(), VehicleIds::find(model.get(), scene.mjcf.string()), pose);
+  setVehiclePose(model.get(), data.get(), vehicle.ids, pose);
 
   EglContext gl;
   Camera camera(model.get(), gl, camera_config, job.seed);

@@ -10,8 +10,9 @@
 namespace tgnav::harness {
 
 struct RenderJob {
-  std::filesystem::path scene;  // scene YAML, or an MJCF that includes the vehicle
-  std::string pose;             // "x,y,z,yaw"; "" = the scene's start (required for an MJCF)
+  std::filesystem::path scene;    // scene YAML, or an MJCF that includes the vehicle
+  std::string pose;               // "x,y,z,yaw"; "" = the scene's start (required for an MJCF)
+  std::filesystem::path vehicle;  // vehicle description; empty: the scene's
   std::filesystem::path out;
   std::string camera_config;    // camera YAML; "" = built-in
   std::optional<int> width_px;  // override the camera config

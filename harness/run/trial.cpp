@@ -17,6 +17,7 @@
 #include "harness/sim/egl_context.h"
 #include "harness/sim/imu_sim.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 
 namespace tgnav::harness {
 
@@ -87,15 +88,16 @@ class ClosedLoop {
         cfg_(scenario.trial),
         trajectory_(trajectory),
         result_(result),
-        model_(loadModel(scenario.scene.mjcf)),
+        vehicle_(loadVehicleModel(scenario.scene.mjcf, scenario.vehicle)),
+        model_(std::move(vehicle_.model)),
         data_(makeData(model_.get())),
         view_(makeData(model_.get())),
-        ids_(VehicleIds::find(model_.get(), scenario.scene.mjcf.string())),
+        ids_(vehicle_.ids),
         landed_(placeOnGround(scenario.scene, model_.get(), data_.get(), ids_)),
         loop_(model_.get(), data_.get(), ids_, scenario.controller),
         steps_per_frame_(stepsPerTick(model_.get(), cfg_.camera_rate_hz, "trial.camera_rate_hz =")),
         timeline_(flightTimeline(loop_, trajectory, cfg_.flight)),
-        camera_(model_.get(), gl_, scenario.camera, 0),  // renders noiseless; noise in the VO stage
+        camera_(model_.get(), gl_, scenario.camera.on(vehicle_.vehicle.camera), 0),  // noise: in the VO stage
         noise_(scenario.camera, trialSeed(options.seed, 1)),
         imu_(cfg_.imu, ids_, trialSeed(options.seed, 2)),
         estimator_(cfg_.estimator, loop_.vehicle().gravity_m_s2),
@@ -104,7 +106,7 @@ class ClosedLoop {
         reinitialise_(scenario.vo.reinitialise_after_lost),
         vehicle_root_(model_->body_rootid[ids_.body]) {
     result_->planned_flight_s = timeline_.end_s;
-    result_->X_BC = cameraInBody(model_.get(), mj_name2id(model_.get(), mjOBJ_CAMERA, scenario.camera.name.c_str()));
+    result_->X_BC = cameraInBody(model_.get(), camera_.id());
     X_CB_ = result_->X_BC.inverse();
     estimator_.reset(loop_.state(), loop_.time());
   }
@@ -143,7 +145,7 @@ class ClosedLoop {
   // Puts the vehicle on the ground at the start, facing the start yaw, and returns that pose.
   static planner::Pose4 placeOnGround(const SceneConfig& scene, const mjModel* m, mjData* d, const VehicleIds& ids) {
     planner::Pose4 landed = scene.start;
-    landed.p_WB.z() = scene.bounds_min_m.z() + kLandedHeightM;
+    landed.p_WB.z() = scene.bounds_min_m.z() + ids.landed_height_m;
     setVehiclePose(m, d, ids, landed);
     return landed;
   }
@@ -300,6 +302,7 @@ class ClosedLoop {
   const TrialConfig& cfg_;
   const control::SetpointTrajectory& trajectory_;
   TrialResult* result_;
+  VehicleModel vehicle_;  // its model moves to model_
   ModelPtr model_;
   DataPtr data_;
   DataPtr view_;

@@ -5,6 +5,7 @@
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
+#include "harness/config/vehicle_config.h"
 #include "harness/io/staged_output.h"
 #include "harness/scenes/scene_files.h"
 
@@ -65,8 +66,11 @@ GeneratedScene generateScene(SceneKind kind, std::uint64_t seed) {
   }
   const std::filesystem::path vehicle = modelsDir() / "quadrotor.xml";
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(vehicle, ec)) {
-    throw InputError(vehicle.string() + ": the vehicle model is missing (set TGNAV_MODELS_DIR to the models folder)");
+  const std::filesystem::path description = descriptionBeside(vehicle);
+  if (!std::filesystem::is_regular_file(vehicle, ec) || description.empty()) {
+    throw InputError(vehicle.string() +
+                     ": the vehicle model or its description .yaml is missing (set TGNAV_MODELS_DIR to the models "
+                     "folder)");
   }
   SceneRng texture_rng(mixSeed(seed, kTextureStream + static_cast<std::uint64_t>(kind)));
   SceneRng material_rng(mixSeed(seed, kMaterialStream + 16 * static_cast<std::uint64_t>(kind)));
@@ -76,7 +80,9 @@ GeneratedScene generateScene(SceneKind kind, std::uint64_t seed) {
   scene.files[sceneFile(kind, seed)] = sceneYaml(scene.layout, name);
   scene.files[scenarioFile(kind, seed)] = scenarioYaml(scene.layout, name);
   scene.files["generated.json"] = generatedJson(scene.layout, faces);
+  // The vehicle by the same reference as the shipped scenes: its MJCF and its description.
   scene.files["quadrotor.xml"] = readTextFile(vehicle);
+  scene.files["quadrotor.yaml"] = readTextFile(description);
   return scene;
 }
 

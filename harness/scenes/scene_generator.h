@@ -2,6 +2,8 @@
 // `tgnav scene generate`: a complete, procedurally generated scene from a kind and a seed, which
 // every tgnav command accepts. Files (relative to the output folder; NAME = <kind>-<seed>):
 //   NAME.xml              MJCF; includes quadrotor.xml (a byte copy of models/quadrotor.xml)
+//   quadrotor.yaml        its vehicle description (a byte copy of models/quadrotor.yaml); a
+//                         scenario's `vehicle:` flies the scene with another airframe
 //   scenes/NAME.yaml      scene YAML (harness/config/scene_config.h) with `mjcf: ../NAME.xml`
 //   scenarios/NAME.yaml   scenario naming the scene, seed 1 and the camera noise; built-in defaults
 //   generated.json  what was generated: kind, seed, room, obstacles, every surface and its level

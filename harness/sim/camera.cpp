@@ -10,11 +10,6 @@
 
 namespace tgnav::harness {
 
-namespace {
-// Vehicle geoms live in group 2 (models/quadrotor.xml); the onboard camera must not see them.
-constexpr int kVehicleGeomGroup = 2;
-}  // namespace
-
 Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px) {
   Intrinsics k;
   k.width_px = width_px;
@@ -29,6 +24,9 @@ Intrinsics intrinsicsFromFovy(double fovy_deg, int width_px, int height_px) {
 
 Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std::uint64_t seed)
     : model_(m), gl_(gl), config_(config), noise_(config, seed) {
+  if (config_.name == kVehicleCamera) {
+    throw std::logic_error("Camera: the camera name 'vehicle' must be resolved (CameraConfig::on)");
+  }
   cam_id_ = mj_name2id(m, mjOBJ_CAMERA, config_.name.c_str());
   if (cam_id_ < 0) throw InputError("camera '" + config_.name + "' is not in the model");
 
@@ -47,7 +45,9 @@ Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std
   view_.type = mjCAMERA_FIXED;
   view_.fixedcamid = cam_id_;
   mjv_defaultOption(&option_);
-  option_.geomgroup[kVehicleGeomGroup] = 0;
+  // The onboard camera must not see its own vehicle (arms, propellers): every geom and site of
+  // the body tree it is mounted on is left out of the scene it draws (a camera of the world sees all).
+  vehicle_root_ = m->cam_bodyid[cam_id_] == 0 ? -1 : m->body_rootid[m->cam_bodyid[cam_id_]];
   mjv_defaultScene(&scene_);
   mjv_makeScene(m, &scene_, 2000);
   scene_.flags[mjRND_SHADOW] = 0;
@@ -100,6 +100,20 @@ RgbdFrame Camera::render(mjData* d) {
   return frame;
 }
 
+void Camera::hideVehicle() {
+  if (vehicle_root_ < 0) return;
+  int kept = 0;
+  for (int i = 0; i < scene_.ngeom; ++i) {
+    const mjvGeom& g = scene_.geoms[i];
+    const int body = g.objtype == mjOBJ_GEOM   ? model_->geom_bodyid[g.objid]
+                     : g.objtype == mjOBJ_SITE ? model_->site_bodyid[g.objid]
+                                               : -1;
+    const bool own = body >= 0 && model_->body_rootid[body] == vehicle_root_;
+    if (!own) scene_.geoms[kept++] = g;
+  }
+  scene_.ngeom = kept;
+}
+
 RgbdFrame Camera::renderNoiseless(mjData* d) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point t0 = Clock::now();
@@ -107,6 +121,7 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
   const int w = config_.width_px;
   const int h = config_.height_px;
   mjv_updateScene(model_, d, &option_, nullptr, &view_, mjCAT_ALL, &scene_);
+  hideVehicle();
   // Several cameras may share one GL context: bind this camera's framebuffer every time.
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, w, h};

@@ -73,11 +73,15 @@ class Camera {
   // Pose of C in W for the current state of `d`.
   Eigen::Isometry3d pose(const mjData* d) const;
   const Intrinsics& intrinsics() const { return intrinsics_; }
+  int id() const { return cam_id_; }  // the MJCF camera's id
 
  private:
+  void hideVehicle();
+
   const mjModel* model_;
   const EglContext& gl_;
   CameraConfig config_;
+  int vehicle_root_ = -1;  // root body of the vehicle the camera is mounted on; -1: none
   Intrinsics intrinsics_;
   int cam_id_ = -1;
   double near_m_ = 0.0;

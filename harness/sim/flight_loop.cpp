@@ -27,6 +27,35 @@ FlightLoop::FlightLoop(mjModel* m, mjData* d, const VehicleIds& ids, const contr
   per_rate_ = stepsPerTick(m, config.rate_rate_hz, "controller rates_hz.rate =");
   per_attitude_ = stepsPerTick(m, config.attitude_rate_hz, "controller rates_hz.attitude =");
   per_position_ = stepsPerTick(m, config.position_rate_hz, "controller rates_hz.position =");
+  const double dt = m->opt.timestep;
+  direct_alpha_ = ids.direct_lag_s > 0.0 ? 1.0 - std::exp(-dt / ids.direct_lag_s) : 1.0;
+  command_n_ = Eigen::VectorXd::Zero(ids.rotorCount());
+  thrust_n_ = Eigen::VectorXd::Zero(ids.rotorCount());
+  for (int i = 0; i < ids.rotorCount(); ++i) {
+    // Start from what the model holds (a test may have set the motors spinning).
+    command_n_[i] = d->ctrl[ids.motors[i]] / ids.ctrl_per_n[i];
+    thrust_n_[i] = ids.motor_act[i] >= 0 ? d->act[ids.motor_act[i]] / ids.ctrl_per_n[i] : command_n_[i];
+  }
+}
+
+void FlightLoop::setMotorThrusts(const Eigen::VectorXd& thrust_n) {
+  command_n_ = thrust_n;
+  thrust_n_ = thrust_n;
+  for (int i = 0; i < ids_.rotorCount(); ++i) {
+    d_->ctrl[ids_.motors[i]] = thrust_n[i] * ids_.ctrl_per_n[i];
+    if (ids_.motor_act[i] >= 0) d_->act[ids_.motor_act[i]] = thrust_n[i] * ids_.ctrl_per_n[i];
+  }
+}
+
+void FlightLoop::applyMotors() {
+  for (int i = 0; i < ids_.rotorCount(); ++i) {
+    if (ids_.motor_act[i] >= 0) {  // MuJoCo's filter is the motor lag
+      d_->ctrl[ids_.motors[i]] = command_n_[i] * ids_.ctrl_per_n[i];
+    } else {  // direct thrust: the lag of the vehicle description, here
+      thrust_n_[i] += direct_alpha_ * (command_n_[i] - thrust_n_[i]);
+      d_->ctrl[ids_.motors[i]] = thrust_n_[i] * ids_.ctrl_per_n[i];
+    }
+  }
 }
 
 void FlightLoop::setDivergenceLimits(double tilt_rad, double speed_m_s) {
@@ -61,8 +90,9 @@ bool FlightLoop::step(const control::TrajectorySetpoint& setpoint, const control
       divergence_ = "non-finite motor command";
       return false;
     }
-    for (int i = 0; i < 4; ++i) d_->ctrl[ids_.motors[i]] = thrust_n[i];
+    command_n_ = thrust_n;
   }
+  applyMotors();
   const Clock::time_point t1 = Clock::now();
   mj_step(m_, d_);
   physics_wall_s_ += std::chrono::duration<double>(Clock::now() - t1).count();

@@ -43,17 +43,26 @@ class FlightLoop {
   bool positionUpdateDue() const { return steps_ % per_position_ == 0; }
   const std::string& divergence() const { return divergence_; }
   const control::VehicleParams& vehicle() const { return vehicle_; }
+  // Sets every rotor's thrust (newtons) as if its motor had settled there: the command, the
+  // filter state of filtered actuators and the lag state of direct-thrust ones (e.g. to start a
+  // test in hover).
+  void setMotorThrusts(const Eigen::VectorXd& thrust_n);
   // Thresholds of the divergence check.
   void setDivergenceLimits(double tilt_rad, double speed_m_s);
 
  private:
   bool checkDiverged();
+  // Writes the motor commands into the model's controls (through the lag of direct-thrust ones).
+  void applyMotors();
 
   mjModel* m_;
   mjData* d_;
   VehicleIds ids_;
   control::VehicleParams vehicle_;
   control::Cascade cascade_;
+  Eigen::VectorXd command_n_;  // per rotor, from the allocation
+  Eigen::VectorXd thrust_n_;   // per direct-thrust rotor, after its lag
+  double direct_alpha_ = 1.0;  // lag filter gain per physics step
   int per_rate_ = 1;
   int per_attitude_ = 2;
   int per_position_ = 5;

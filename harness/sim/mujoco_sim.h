@@ -1,14 +1,15 @@
 #pragma once
-// RAII ownership of MuJoCo's C objects and the handles of the tgnav quadrotor in a model.
+// RAII ownership of MuJoCo's C objects and the handles of a multirotor in a model.
 #include <mujoco/mujoco.h>
 
-#include <array>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "control/types.h"
 #include "control/vehicle.h"
+#include "harness/config/vehicle_config.h"
 #include "planner/pose4.h"
 
 namespace tgnav::harness {
@@ -33,23 +34,28 @@ DataPtr makeData(const mjModel* m);
 // The warnings MuJoCo counted in `d` (e.g. "mjWARN_BADQACC x3"), "" when there are none.
 std::string mujocoWarnings(const mjData* d);
 
-// Indices of the quadrotor of models/quadrotor.xml inside a model.
+// Indices of a vehicle's parts inside a model, as its description names them
+// (harness/config/vehicle_config.h).
 struct VehicleIds {
   int body = -1;
   int qpos_adr = -1;               // free joint: position (3) then quaternion w, x, y, z (4)
   int qvel_adr = -1;               // free joint: linear velocity in W (3) then angular velocity in B (3)
-  std::array<int, 4> motors{};     // actuator ids, PX4 quad-X order
-  std::array<int, 4> motor_act{};  // their activation (motor-lag filter state) in mjData::act
-  int gyro_adr = -1;               // sensordata offsets
+  std::vector<int> motors;         // actuator ids, in the description's rotor order
+  std::vector<int> motor_act;      // their activation (motor-lag filter state) in mjData::act; -1: direct thrust
+  std::vector<double> ctrl_per_n;  // actuator control per newton of thrust (1 / (gain |gear force|))
+  std::vector<double> max_thrust_n;
+  double direct_lag_s = 0.0;  // first-order lag the flight loop applies to direct-thrust actuators
+  int gyro_adr = -1;          // sensordata offsets
   int accel_adr = -1;
+  int camera = -1;
+  // Height of the body frame's origin above the ground when landed: its lowest collision
+  // geometry 5 mm above the floor (the vehicle settles onto it).
+  double landed_height_m = 0.0;
 
-  // InputError naming `source` if the model lacks any part of the vehicle.
-  static VehicleIds find(const mjModel* m, const std::string& source);
+  int rotorCount() const { return static_cast<int>(motors.size()); }
+  // InputError naming the vehicle's MJCF and the element when a part is missing or unusable.
+  static VehicleIds find(const mjModel* m, const VehicleDescription& vehicle);
 };
-
-// Height of the centre of mass above the ground when landed: hull half-height 0.03 m of
-// models/quadrotor.xml plus 5 mm of clearance; the vehicle settles onto the floor.
-constexpr double kLandedHeightM = 0.035;
 
 // Places the vehicle level at `pose` with zero velocity and recomputes kinematics.
 void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const planner::Pose4& pose);
@@ -59,7 +65,9 @@ double vehicleMass(const mjModel* m, const VehicleIds& ids);
 
 // Mass, inertia and rotor geometry as the model defines them: rotor positions from the
 // actuator sites (relative to the centre of mass), thrust axes and yaw-moment ratios from the
-// actuator gears, maximum thrust from the control ranges, motor lag from the filter constant.
+// actuator gears, maximum thrust from the control ranges (or the description), motor lag from
+// the filter constant (or the description). InputError when the rotors cannot control roll,
+// pitch, yaw and thrust independently.
 control::VehicleParams vehicleParamsFromModel(const mjModel* m, const VehicleIds& ids);
 
 // True state of the vehicle (free-joint position/velocity, body rates).

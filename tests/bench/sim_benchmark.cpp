@@ -9,6 +9,7 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/flight_loop.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 
 namespace tgnav::harness {
 namespace {
@@ -16,9 +17,10 @@ namespace {
 struct Smoke {
   Smoke() {
     const SceneConfig scene = loadSceneConfig(std::string(TGNAV_SOURCE_DIR) + "/configs/scenes/smoke.yaml");
-    model = loadModel(scene.mjcf);
+    VehicleModel vehicle = loadVehicleModel(scene.mjcf);
+    model = std::move(vehicle.model);
     data = makeData(model.get());
-    ids = VehicleIds::find(model.get(), "smoke");
+    ids = vehicle.ids;
     start = scene.start;
     setVehiclePose(model.get(), data.get(), ids, start);
   }
@@ -34,8 +36,8 @@ void BM_RenderRgbd(benchmark::State& state) {
   CameraConfig config;
   config.width_px = static_cast<int>(state.range(0));
   config.height_px = static_cast<int>(state.range(1));
-  Camera camera(smoke.model.get(), gl, config, 0);
-  camera.render(smoke.data.get());  // first frame compiles shaders
+  Camera camera(smoke.model.get(), gl, config.on("front"), 0);  // models/quadrotor.yaml's camera
+  camera.render(smoke.data.get());                              // first frame compiles shaders
   int i = 0;
   for (auto _ : state) {
     planner::Pose4 pose = smoke.start;

@@ -18,6 +18,7 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "vo/metrics.h"
 #include "vo/odometry.h"
 
@@ -36,16 +37,17 @@ const Sequence& sequence(int width) {
   const SceneConfig scene = loadSceneConfig(std::string(TGNAV_SOURCE_DIR) + "/configs/scenes/smoke.yaml");
   const control::SetpointTrajectory traj =
       readTrajectoryCsv(std::string(TGNAV_SOURCE_DIR) + "/configs/trajectories/smoke_around_pillar.csv");
-  ModelPtr model = loadModel(scene.mjcf);
+  VehicleModel vehicle = loadVehicleModel(scene.mjcf);
+  ModelPtr model = std::move(vehicle.model);
   DataPtr data = makeData(model.get());
-  const auto ids = VehicleIds::find(model.get(), scene.mjcf.string());
+  const VehicleIds& ids = vehicle.ids;
   static const EglContext gl;
   CameraConfig config;
   config.width_px = width;
   config.height_px = width * 3 / 4;
   config.rgb_noise_sigma = 2.0;
   config.depth_noise_sigma_per_m2 = 0.002;
-  Camera camera(model.get(), gl, config, 7);
+  Camera camera(model.get(), gl, config.on(vehicle.vehicle.camera), 7);
   Sequence s;
   s.intrinsics = camera.intrinsics();
   for (double t = traj.startTime(); t <= traj.endTime(); t += 0.05) {

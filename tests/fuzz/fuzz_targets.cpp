@@ -12,12 +12,14 @@
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
+#include "harness/config/vehicle_config.h"
 #include "harness/config/yaml_util.h"
 #include "harness/experiments/sweep.h"
 #include "harness/io/grid_io.h"
 #include "harness/io/movingai_scen.h"
 #include "harness/io/trajectory_csv.h"
 #include "harness/io/tum_sequence.h"
+#include "harness/sim/vehicle_model.h"
 #include "vo/trajectory_formats.h"
 #include "vo/tum.h"
 
@@ -69,14 +71,19 @@ void writeSection(const std::vector<std::string>& parts, std::size_t i, const fs
   if (i < parts.size()) write(file, parts[i]);
 }
 
-// The MJCF a scene names: its content is MuJoCo's to parse (not fuzzed here); it must exist.
+// The MJCF a scene names: its content is MuJoCo's to parse (not fuzzed here); it must exist. It
+// includes the vehicle vehicle.xml, described by vehicle.yaml beside it, as the shipped scenes do.
 constexpr const char* kMjcf = "fuzz.xml";
+constexpr const char* kVehicleYaml =
+    "mjcf: vehicle.xml\nbody: b\nrotors: [m0, m1, m2, m3]\ngyro: g\naccelerometer: a\ncamera: c\n";
 
-// Scratch layout of the configuration targets: run/fuzz.xml, run/scenes/fuzz.yaml,
-// run/scenarios/fuzz.yaml, run/sweeps/fuzz.yaml.
+// Scratch layout of the configuration targets: run/fuzz.xml, run/vehicle.{xml,yaml},
+// run/scenes/fuzz.yaml, run/scenarios/fuzz.yaml, run/sweeps/fuzz.yaml.
 fs::path configLayout(const std::vector<std::string>& parts, const std::vector<std::string>& order) {
   const fs::path run = scratch().fresh();
-  write(run / kMjcf, "<mujoco/>\n");
+  write(run / kMjcf, "<mujoco>\n  <include file=\"vehicle.xml\"/>\n</mujoco>\n");
+  write(run / "vehicle.xml", "<mujoco/>\n");
+  write(run / "vehicle.yaml", kVehicleYaml);
   for (std::size_t i = 0; i < order.size(); ++i) writeSection(parts, i, run / order[i] / "fuzz.yaml");
   return run;
 }
@@ -201,6 +208,22 @@ const std::vector<Entry>& entries() {
            harness::loadScenario(run / "scenarios" / "fuzz.yaml", &overrides);
          } else {
            harness::loadScenario(run / "scenarios" / "fuzz.yaml");
+         }
+       }},
+      {{"vehicle", "sections: vehicle description (mjcf may name ../fuzz.xml), scene MJCF scanned for its vehicle"},
+       harnessParser,
+       [](const std::string& t) {
+         const auto parts = sections(t, 2);
+         const fs::path run = configLayout({}, {});
+         if (!parts[0].empty() || parts.size() == 1) {
+           write(run / "vehicles" / "fuzz.yaml", parts[0]);
+           harness::loadVehicleDescription(run / "vehicles" / "fuzz.yaml");
+         }
+         if (parts.size() > 1) {
+           write(run / "scene.xml", parts[1]);
+           if (!harness::includedVehicle(run / "scene.xml").empty()) {
+             harness::composeVehicleScene(run / "scene.xml", harness::loadVehicleDescription(run / "vehicle.yaml"));
+           }
          }
        }},
       {{"sweep", "sections: sweep YAML, scenario YAML (../scenarios/fuzz.yaml), scene YAML"},
@@ -340,11 +363,35 @@ std::vector<std::string> repositorySeeds(const std::string& name, const fs::path
         if (sweep.find("generated:") != std::string::npos) continue;  // each input would write scenes
         // The sweep's scenarios are the repository's (absolute paths: a sweep may list several);
         // the scratch scenario and scene sections are there for the fuzzer to point it at.
-        const std::string pointed =
-            std::regex_replace(sweep, std::regex(R"(\.\./scenarios/)"), (configs / "scenarios").string() + "/");
+        // (and its files of the repository, e.g. vehicles, by absolute path too).
+        const std::string pointed = std::regex_replace(
+            std::regex_replace(sweep, std::regex(R"(\.\./scenarios/)"), (configs / "scenarios").string() + "/"),
+            std::regex(R"(\.\./\.\./)"), source_dir.string() + "/");
         seeds.push_back(join({pointed, scenarioSeed(f), sceneSeed(scene)}));
       }
       break;  // one scenario suffices under every sweep file
+    }
+  } else if (name == "vehicle") {
+    // The repository's vehicle descriptions pointed at the scratch MJCF (their gains files by
+    // absolute path), each with a shipped scene whose vehicle include names the scratch vehicle.
+    std::vector<fs::path> descriptions = {source_dir / "models" / "quadrotor.yaml",
+                                          source_dir / "tests" / "data" / "x2_like" / "x2_like.yaml"};
+    for (const fs::path& f : yamlFiles(source_dir / "models" / "vehicles")) {
+      if (fs::is_regular_file(fs::path(f).replace_extension(".xml"))) descriptions.push_back(f);  // not a gains file
+    }
+    const std::vector<fs::path> scenes = {source_dir / "models" / "scenes" / "smoke.xml",
+                                          source_dir / "models" / "scenes" / "storage.xml"};
+    for (std::size_t i = 0; i < descriptions.size(); ++i) {
+      std::string d = replaceKey(readText(descriptions[i]), "mjcf", std::string("../") + kMjcf);
+      const std::regex gains(R"((^|\n)controller_config:\s*(\S+))");
+      std::smatch m;
+      if (std::regex_search(d, m, gains)) {
+        d = replaceKey(d, "controller_config",
+                       (descriptions[i].parent_path() / m[2].str()).lexically_normal().string());
+      }
+      const std::string scene =
+          std::regex_replace(readText(scenes[i % scenes.size()]), std::regex(R"(\.\./quadrotor\.xml)"), "vehicle.xml");
+      seeds.push_back(join({d, scene}));
     }
   } else if (name == "trajectory_csv") {
     for (const auto& e : fs::directory_iterator(configs / "trajectories")) {

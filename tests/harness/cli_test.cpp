@@ -78,7 +78,8 @@ TEST(CliRender, MjcfWithoutVehicleIsRejected) {
   const auto xml = test::writeFile(dir / "empty.xml", "<mujoco/>");
   const CmdResult run = tgnav("render --scene " + xml.string() + " --pose 0,0,1,0 --out " + (dir / "o").string());
   EXPECT_EQ(run.rc, 2);
-  EXPECT_NE(run.output.find("body 'quadrotor'"), std::string::npos) << run.output;
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(xml.string() + ": includes no vehicle"), std::string::npos) << run.output;
 }
 
 TEST(CliRender, BadResolutionNamesTheValue) {

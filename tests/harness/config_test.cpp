@@ -26,6 +26,7 @@ TEST(CameraConfigFile, ShippedFileEqualsBuiltInDefaults) {
   const CameraConfig file = loadCameraConfig(test::sourceDir() / "configs/camera.yaml");
   const CameraConfig defaults;
   EXPECT_EQ(file.name, defaults.name);
+  EXPECT_EQ(defaults.name, kVehicleCamera);
   EXPECT_EQ(file.width_px, defaults.width_px);
   EXPECT_EQ(file.height_px, defaults.height_px);
   EXPECT_EQ(file.near_clip_m, defaults.near_clip_m);
@@ -490,7 +491,8 @@ TEST_F(ConfigScenario, UnknownKeyViaSetNamesTheAssignment) {
   EXPECT_EQ(msg.rfind("--set camera.widht_px=320: unknown key 'camera.widht_px' (allowed: name, width_px,", 0), 0u)
       << msg;
   const std::string top = error(scenario(""), {"camra.width_px=320"});
-  EXPECT_EQ(top.rfind("--set camra.width_px=320: unknown key 'camra' (allowed: scene, seed, start, goal,", 0), 0u)
+  EXPECT_EQ(top.rfind("--set camra.width_px=320: unknown key 'camra' (allowed: scene, vehicle, seed, start, goal,", 0),
+            0u)
       << top;
   const std::string nested = error(scenario(""), {"vo={features: {max_feature: 3}}"});
   EXPECT_EQ(nested.rfind("--set vo={features: {max_feature: 3}}: unknown key 'vo.features.max_feature'", 0), 0u)
@@ -635,6 +637,7 @@ TEST_F(ConfigScenario, ResolvedStorageScenarioLoadsBackIdentically) {
   EXPECT_EQ(resolvedScenarioYaml(back), text);
   EXPECT_EQ(text.rfind("# ", 0), 0u);
   EXPECT_NE(text.find("\nscene: " + (test::sourceDir() / "configs/scenes/storage.yaml").lexically_normal().string() +
+                      "\nvehicle: " + (test::sourceDir() / "models/quadrotor.yaml").lexically_normal().string() +
                       "\nseed: 1\nstart: ["),
             std::string::npos)
       << text;
@@ -858,7 +861,7 @@ TEST(ConfigArchive, RequiredKeysAndUnknownKeysFirst) {
                                     "survey: {spacing_m: 1.0, heights_m: [0.8], yaw_count: 8, clearance_m: 0.4}\n");
   EXPECT_EQ(inputError([&] { loadSceneConfig(typo); })
                 .rfind(typo.string() + ":3: unknown key 'strat' (allowed: mjcf, "
-                                       "flight_height_m, start, goal, bounds, survey)",
+                                       "flight_height_m, start, goal, bounds, survey, vehicle)",
                        0),
             0u);
   const auto nested = test::writeFile(dir / "scene2.yaml",

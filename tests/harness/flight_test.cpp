@@ -8,6 +8,7 @@
 #include "harness/config/config_io.h"
 #include "harness/config/scene_config.h"
 #include "harness/sim/flight_loop.h"
+#include "harness/sim/vehicle_model.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -19,9 +20,10 @@ class FlightTest : public ::testing::Test {
  protected:
   void SetUp() override {
     scene_ = loadSceneConfig(test::sourceDir() / "configs/scenes/empty.yaml");
-    model_ = loadModel(scene_.mjcf);
+    VehicleModel vehicle = loadVehicleModel(scene_.mjcf);
+    model_ = std::move(vehicle.model);
     data_ = makeData(model_.get());
-    ids_ = VehicleIds::find(model_.get(), "empty");
+    ids_ = vehicle.ids;
     config_ = loadCascadeConfig(test::sourceDir() / "configs/controller.yaml");
     loop_ = std::make_unique<FlightLoop>(model_.get(), data_.get(), ids_, config_);
   }
@@ -178,6 +180,87 @@ TEST_F(FlightTest, FigureEightAt1mpsTrackedWithin5cmRmse) {
   EXPECT_GT(peak_speed, 0.95);
   EXPECT_LT(peak_speed, 1.1);
 }
+
+// Every shipped airframe and the X2-like test model (direct-thrust motors, rotors at two heights,
+// asymmetric arms) fly the same scene, each composed into it by reference and flown on its own
+// gains (its description's gains file, else the built-in defaults).
+class AirframeFlight : public ::testing::TestWithParam<const char*> {
+ protected:
+  void SetUp() override {
+    const SceneConfig scene = loadSceneConfig(test::sourceDir() / "configs/scenes/empty.yaml");
+    vehicle_ = loadVehicleModel(scene.mjcf, test::sourceDir() / GetParam());
+    data_ = makeData(vehicle_.model.get());
+    if (!vehicle_.vehicle.controller_config.empty()) {
+      config_ = loadCascadeConfig(vehicle_.vehicle.controller_config);
+    }
+    loop_ = std::make_unique<FlightLoop>(vehicle_.model.get(), data_.get(), vehicle_.ids, config_);
+  }
+  void place(const Eigen::Vector3d& p) {
+    planner::Pose4 pose;
+    pose.p_WB = p;
+    setVehiclePose(vehicle_.model.get(), data_.get(), vehicle_.ids, pose);
+  }
+
+  VehicleModel vehicle_;
+  DataPtr data_;
+  control::CascadeConfig config_;
+  std::unique_ptr<FlightLoop> loop_;
+};
+
+TEST_P(AirframeFlight, HoverHoldsWithin2cmAfterADisturbedStart) {
+  // As HoverHoldsWithin2cmFor20s: 10 deg roll, drifting, motors idle; recover 5 s, hold 20 s.
+  const Eigen::Vector3d p(1.0, -2.0, 1.5);
+  place(p);
+  const VehicleIds& ids = vehicle_.ids;
+  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitX()));
+  mjtNum* q = data_->qpos + ids.qpos_adr;
+  q[3] = tilted.w();
+  q[4] = tilted.x();
+  q[5] = tilted.y();
+  q[6] = tilted.z();
+  data_->qvel[ids.qvel_adr] = 0.3;
+  data_->qvel[ids.qvel_adr + 1] = -0.2;
+  data_->qvel[ids.qvel_adr + 2] = 0.1;
+  const control::VehicleParams& v = loop_->vehicle();
+  const auto n = static_cast<Eigen::Index>(v.rotors.size());
+  loop_->setMotorThrusts(Eigen::VectorXd::Zero(n));
+  mj_forward(vehicle_.model.get(), data_.get());
+  control::TrajectorySetpoint sp;
+  sp.p_WB = p;
+  const int settle = static_cast<int>(std::lround(5.0 / vehicle_.model->opt.timestep));
+  for (int i = 0; i < settle; ++i) ASSERT_TRUE(loop_->step(sp)) << loop_->divergence();
+  double worst = 0.0;
+  const int hold = static_cast<int>(std::lround(20.0 / vehicle_.model->opt.timestep));
+  for (int i = 0; i < hold; ++i) {
+    ASSERT_TRUE(loop_->step(sp)) << loop_->divergence();
+    worst = std::max(worst, (loop_->state().p_WB - p).norm());
+  }
+  std::cout << "[ figure   ] " << GetParam() << ": " << n << " rotors, " << v.mass_kg << " kg, hover "
+            << v.hoverThrust() << "; hover 20 s: max deviation " << worst << " m\n";
+  EXPECT_LT(worst, 0.02);
+  EXPECT_GT(worst, 0.0);
+  EXPECT_EQ(mujocoWarnings(data_.get()), "");
+}
+
+TEST_P(AirframeFlight, FigureEightAt1mpsTrackedWithin5cmRmse) {
+  const control::SetpointTrajectory traj = figureEight(Eigen::Vector3d(0, 0, 1.5), 2.0, 3.0);
+  place(Eigen::Vector3d(0, 0, vehicle_.ids.landed_height_m));
+  const FlightResult result = flyTrajectory(*loop_, traj, FlightConfig{});
+  ASSERT_EQ(result.status, FlightStatus::kCompleted) << result.reason;
+  const TrackingSummary s = summarizeTracking(result);
+  std::cout << "[ figure   ] " << GetParam() << ": figure-8 at 1 m/s: rmse " << s.position_rmse_m << " m, max "
+            << s.position_max_m << " m, final " << s.final_error_m << " m\n";
+  EXPECT_LT(s.position_rmse_m, 0.05);
+  EXPECT_LT(s.final_error_m, 0.05);
+  EXPECT_EQ(mujocoWarnings(data_.get()), "");
+}
+
+INSTANTIATE_TEST_SUITE_P(Airframes, AirframeFlight,
+                         ::testing::Values("models/quadrotor.yaml", "models/vehicles/quad250.yaml",
+                                           "models/vehicles/hexarotor.yaml", "tests/data/x2_like/x2_like.yaml"),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           return std::filesystem::path(info.param).stem().string();
+                         });
 
 TEST_F(FlightTest, YawTrackedWithin3DegAt0p3RadPerSecondAcrossPi) {
   const Eigen::Vector3d p(0, 0, 1.5);

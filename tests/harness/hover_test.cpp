@@ -6,6 +6,7 @@
 
 #include "harness/config/scene_config.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "test_util.h"
 
 namespace tgnav::harness {
@@ -15,9 +16,10 @@ class VehicleTest : public ::testing::Test {
  protected:
   void SetUp() override {
     scene_ = loadSceneConfig(test::sourceDir() / "configs/scenes/smoke.yaml");
-    model_ = loadModel(scene_.mjcf);
+    VehicleModel vehicle = loadVehicleModel(scene_.mjcf);
+    model_ = std::move(vehicle.model);
     data_ = makeData(model_.get());
-    ids_ = VehicleIds::find(model_.get(), "smoke");
+    ids_ = vehicle.ids;
     setVehiclePose(model_.get(), data_.get(), ids_, scene_.start);
   }
   // Commands per-rotor thrust, with the motor filter already settled at that value.

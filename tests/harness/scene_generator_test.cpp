@@ -17,6 +17,7 @@
 #include "harness/config/scenario.h"
 #include "harness/scenes/scene_textures.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "test_util.h"
 
 namespace tgnav::harness::scenes {
@@ -109,6 +110,7 @@ TEST(SceneGenerator, SameSeedGivesTheSameBytesInAnyFolder) {
     EXPECT_EQ(bytesOf(dir / "deeper" / "two" / name), bytes) << name;
   }
   EXPECT_EQ(bytesOf(dir / "one" / "quadrotor.xml"), bytesOf(test::sourceDir() / "models/quadrotor.xml"));
+  EXPECT_EQ(bytesOf(dir / "one" / "quadrotor.yaml"), bytesOf(test::sourceDir() / "models/quadrotor.yaml"));
   EXPECT_EQ(test::stagingLeftIn(dir), 0);
 }
 
@@ -141,8 +143,7 @@ TEST(SceneGenerator, EveryKindLoadsCompilesAndKeepsItsGuarantees) {
       EXPECT_EQ(scenario.source.stem(), sceneName(kind, seed));
       EXPECT_EQ(scenario.scene.mjcf, scene.mjcf);
       EXPECT_DOUBLE_EQ(scenario.camera.rgb_noise_sigma, 2.0);
-      const ModelPtr model = loadModel(scene.mjcf);
-      EXPECT_NO_THROW(VehicleIds::find(model.get(), scene.mjcf.string()));
+      const ModelPtr model = loadVehicleModel(scene.mjcf, scene.vehicle).model;
       const std::vector<Footprint> fps = footprints(model.get());
       EXPECT_GE(clearance(fps, scene.start.p_WB.x(), scene.start.p_WB.y()), 1.0);
       EXPECT_GE(clearance(fps, scene.goal.p_WB.x(), scene.goal.p_WB.y()), 1.0);
@@ -200,7 +201,7 @@ TEST(SceneGeneratorCli, WritesAScene) {
   const test::CmdResult run = tgnav("scene generate --seed 4 --kind corridors --out " + out.string());
   ASSERT_EQ(run.rc, 0) << run.output;
   for (const char* f : {"corridors-4.xml", "scenes/corridors-4.yaml", "scenarios/corridors-4.yaml", "generated.json",
-                        "quadrotor.xml"}) {
+                        "quadrotor.xml", "quadrotor.yaml"}) {
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   }
   EXPECT_FALSE(fs::is_empty(out / "textures"));

@@ -7,6 +7,7 @@
 #include "harness/config/scene_config.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "test_util.h"
 #include "vo/features.h"
 
@@ -17,10 +18,11 @@ class SceneTextureTest : public ::testing::Test {
  protected:
   void SetUp() override {
     const SceneConfig scene = loadSceneConfig(test::sourceDir() / "configs/scenes/smoke.yaml");
-    model_ = loadModel(scene.mjcf);
+    VehicleModel vehicle = loadVehicleModel(scene.mjcf);
+    model_ = std::move(vehicle.model);
     data_ = makeData(model_.get());
-    ids_ = VehicleIds::find(model_.get(), "smoke");
-    camera_ = std::make_unique<Camera>(model_.get(), gl_, CameraConfig{}, 0);
+    ids_ = vehicle.ids;
+    camera_ = std::make_unique<Camera>(model_.get(), gl_, CameraConfig{}.on(vehicle.vehicle.camera), 0);
   }
   // Keypoints seen from the vehicle at (x, y, z, yaw), pitched by `pitch_rad` (nose down > 0).
   int keypointsFrom(double x, double y, double z, double yaw_rad, double pitch_rad = 0.0) {

@@ -12,6 +12,7 @@
 #include "harness/sim/flight_loop.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
+#include "harness/sim/vehicle_model.h"
 #include "planner/topological_planner.h"
 #include "test_util.h"
 
@@ -119,9 +120,10 @@ TEST(SceneTrajectory, StorageProposedTrajectoryRoundTripsAndIsFlownClearOfTheSce
     ASSERT_EQ(r.yaw_rad, w.yaw_rad) << i;
   }
 
-  ModelPtr model = loadModel(scenario.scene.mjcf);
+  VehicleModel vehicle = loadVehicleModel(scenario.scene.mjcf, scenario.vehicle);
+  ModelPtr model = std::move(vehicle.model);
   DataPtr data = makeData(model.get());
-  const auto ids = VehicleIds::find(model.get(), scenario.scene.mjcf.string());
+  const VehicleIds& ids = vehicle.ids;
   planner::Pose4 landed = scenario.scene.start;
   landed.p_WB.z() = scenario.scene.bounds_min_m.z() + 0.035;
   setVehiclePose(model.get(), data.get(), ids, landed);

@@ -12,6 +12,7 @@
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "test_util.h"
 #include "vo/metrics.h"
 #include "vo/odometry.h"
@@ -29,17 +30,18 @@ struct VoRun {
 // `ablate`, if set, may change the model (e.g. materials) before rendering.
 VoRun flyPast(const std::vector<planner::Pose4>& poses, const std::function<void(mjModel*)>& ablate = nullptr) {
   const SceneConfig scene = loadSceneConfig(test::sourceDir() / "configs/scenes/smoke.yaml");
-  ModelPtr model = loadModel(scene.mjcf);
+  VehicleModel vehicle = loadVehicleModel(scene.mjcf);
+  ModelPtr model = std::move(vehicle.model);
   if (ablate) ablate(model.get());
   DataPtr data = makeData(model.get());
-  const auto ids = VehicleIds::find(model.get(), scene.mjcf.string());
+  const VehicleIds& ids = vehicle.ids;
   const EglContext gl;
   CameraConfig config;
   config.width_px = 320;
   config.height_px = 240;
   config.rgb_noise_sigma = 2.0;
   config.depth_noise_sigma_per_m2 = 0.002;
-  Camera camera(model.get(), gl, config, 7);
+  Camera camera(model.get(), gl, config.on(vehicle.vehicle.camera), 7);
   const Intrinsics& k = camera.intrinsics();
   std::unique_ptr<vo::RgbdOdometry> odometry;
   VoRun run;
