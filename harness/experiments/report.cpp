@@ -14,6 +14,7 @@
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
 #include "harness/experiments/report_trial.h"
+#include "harness/experiments/sweep.h"
 #include "harness/io/staged_output.h"
 
 namespace tgnav::harness {
@@ -293,7 +294,7 @@ std::string plannerLabel(const std::string& planner, int samples, const std::str
                       : planner == "agnostic" ? "AP"
                       : planner == "rrtstar"  ? "R-" + std::to_string(samples)
                                               : planner;
-  if (!params.empty()) label += " [" + params + "]";
+  if (!params.empty()) label += " [" + paramsLabel(params) + "]";
   return label;
 }
 

@@ -144,15 +144,27 @@ std::string sanitise(const std::string& text) {
   return out;
 }
 
+}  // namespace
+
+std::string paramsLabel(const std::string& params) {
+  std::string out;
+  std::stringstream in(params);
+  std::string item;
+  while (std::getline(in, item, ';')) {
+    if (item.rfind("vehicle=", 0) == 0) item = "vehicle=" + fs::path(item.substr(8)).stem().string();
+    out += (out.empty() ? "" : ";") + item;
+  }
+  return out;
+}
+
+namespace {
+
 std::string trialId(const SweepTrial& t, std::size_t seed_width) {
   std::string id = fs::path(t.scenario).stem().string() + "__" + t.planner;
   if (t.planner == "rrtstar") id += "-" + std::to_string(t.samples);
-  std::stringstream params(t.params);
+  std::stringstream params(paramsLabel(t.params));
   std::string item;
-  while (std::getline(params, item, ';')) {
-    if (item.rfind("vehicle=", 0) == 0) item = "vehicle=" + fs::path(item.substr(8)).stem().string();  // its name
-    id += "__" + sanitise(item);
-  }
+  while (std::getline(params, item, ';')) id += "__" + sanitise(item);
   std::string seed = std::to_string(t.seed);
   if (seed.size() < seed_width) seed.insert(0, seed_width - seed.size(), '0');
   return id + "__s" + seed;

@@ -82,4 +82,8 @@ std::vector<SweepTrial> parseManifest(const std::string& text, const std::string
 // be run in DIR. It pins the sweep down: a re-run must expand to the same commands.
 std::string commandsText(const std::vector<SweepTrial>& trials);
 
+// A trial's params ("key=value;key=value") as trial ids and report labels show them: a
+// `vehicle` file by its name ("vehicle=hexarotor").
+std::string paramsLabel(const std::string& params);
+
 }  // namespace tgnav::harness

@@ -122,6 +122,40 @@ TEST(Sweep, RrtStarWithoutSamplesTakesTheConfiguredBudget) {
   EXPECT_EQ(s.trials[0].id, "smoke__rrtstar-1000__s03");
 }
 
+TEST(Sweep, VehicleAxisIsAFileRelativeToTheSweepNamedByItsStem) {
+  const fs::path dir = test::tempDir();
+  const std::string hex = (test::sourceDir() / "models/vehicles/hexarotor.yaml").string();
+  for (const char* f : {"hexarotor.xml", "hexarotor_gains.yaml"})
+    fs::copy_file(test::sourceDir() / "models/vehicles" / f, dir / f);
+  fs::copy_file(hex, dir / "hexcopy.yaml");
+  const Sweep s = loadSweep(sweepFile(dir,
+                                      "seeds: [1]\nruns:\n  - {scenario: SC/smoke.yaml, planner: proposed, axes: "
+                                      "{vehicle: [" +
+                                          hex + ", ./hexcopy.yaml]}}\n"));
+  ASSERT_EQ(s.trials.size(), 2u);
+  EXPECT_EQ(s.trials[0].params, "vehicle=" + hex);
+  EXPECT_EQ(s.trials[1].params, "vehicle=" + (dir / "hexcopy.yaml").string());  // absolute: runs anywhere
+  EXPECT_EQ(s.trials[0].id, "smoke__proposed__vehicle=hexarotor__s01");
+  EXPECT_EQ(s.trials[1].id, "smoke__proposed__vehicle=hexcopy__s01");
+  EXPECT_EQ(paramsLabel(s.trials[0].params), "vehicle=hexarotor");
+  const std::string msg = test::inputError([&] {
+    loadSweep(sweepFile(dir,
+                        "seeds: [1]\nruns:\n  - {scenario: SC/smoke.yaml, planner: proposed, set: {vehicle: "
+                        "nope.yaml}}\n"));
+  });
+  EXPECT_NE(msg.find("vehicle: file " + (dir / "nope.yaml").string() + " not found"), std::string::npos) << msg;
+  // Trials are named by the vehicle's file name: two vehicles of one name in one sweep collide.
+  fs::create_directories(dir / "other");
+  fs::copy_file(hex, dir / "other" / "hexarotor.yaml");
+  fs::copy_file(dir / "hexarotor.xml", dir / "other" / "hexarotor.xml");
+  fs::copy_file(dir / "hexarotor_gains.yaml", dir / "other" / "hexarotor_gains.yaml");
+  const std::string twice = test::inputError([&] {
+    loadSweep(sweepFile(dir, "seeds: [1]\nruns:\n  - {scenario: SC/smoke.yaml, planner: proposed, axes: {vehicle: [" +
+                                 hex + ", other/hexarotor.yaml]}}\n"));
+  });
+  EXPECT_NE(twice.find("smoke__proposed__vehicle=hexarotor__s01 is listed twice"), std::string::npos) << twice;
+}
+
 TEST(Sweep, ListValuesAndTheirIds) {
   const fs::path dir = test::tempDir();
   const Sweep s = loadSweep(sweepFile(dir,
