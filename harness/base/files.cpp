@@ -19,4 +19,9 @@ std::string readTextFile(const std::filesystem::path& file) {
   return text;
 }
 
+bool isRegularFile(const std::filesystem::path& file) noexcept {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(file, ec);
+}
+
 }  // namespace tgnav::harness

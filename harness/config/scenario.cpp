@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/config/config_io.h"
 #include "harness/config/vehicle_config.h"
 
@@ -26,7 +27,7 @@ std::vector<std::string> sectionKeys() {
 fs::path existingFile(const YamlDoc& doc, const std::string& key, const fs::path& base) {
   const std::string text = doc.string(doc.root(), key, "");
   fs::path p = fs::absolute(base / text).lexically_normal();
-  if (!fs::is_regular_file(p)) {
+  if (!isRegularFile(p)) {
     doc.failKey(doc.root()[key], key, "key '" + key + "' has value '" + text + "': file " + p.string() + " not found");
   }
   return p;

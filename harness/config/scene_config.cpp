@@ -1,6 +1,7 @@
 #include "harness/config/scene_config.h"
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/config/vehicle_config.h"
 #include "harness/config/yaml_util.h"
 
@@ -14,13 +15,13 @@ SceneConfig loadSceneConfig(const std::filesystem::path& yaml) {
   scene.source = yaml;
   const std::string mjcf = scene.mjcf.string();
   scene.mjcf = std::filesystem::absolute(yaml.parent_path() / mjcf).lexically_normal();
-  if (!std::filesystem::is_regular_file(scene.mjcf)) {
+  if (!isRegularFile(scene.mjcf)) {
     doc.fail(root["mjcf"], "key 'mjcf' has value '" + mjcf + "': file " + scene.mjcf.string() + " not found");
   }
   if (!scene.vehicle.empty()) {
     const std::string text = scene.vehicle.string();
     scene.vehicle = std::filesystem::absolute(yaml.parent_path() / text).lexically_normal();
-    if (!std::filesystem::is_regular_file(scene.vehicle)) {
+    if (!isRegularFile(scene.vehicle)) {
       doc.fail(root["vehicle"],
                "key 'vehicle' has value '" + text + "': file " + scene.vehicle.string() + " not found");
     }
@@ -61,7 +62,7 @@ SceneConfig loadSceneConfig(const std::filesystem::path& yaml) {
 SceneConfig loadScene(const std::filesystem::path& path) {
   const std::string ext = path.extension().string();
   if (ext == ".xml" || ext == ".mjcf") {
-    if (!std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": file not found");
+    if (!isRegularFile(path)) throw InputError(path.string() + ": file not found");
     SceneConfig scene;
     scene.source = path;
     scene.mjcf = std::filesystem::absolute(path).lexically_normal();

@@ -36,7 +36,7 @@ double positive(const YamlDoc& doc, const YAML::Node& map, const std::string& ke
 fs::path existing(const YamlDoc& doc, const YAML::Node& map, const std::string& key) {
   const std::string text = name(doc, map, key, "");
   const fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
-  if (!fs::is_regular_file(p)) {
+  if (!isRegularFile(p)) {
     doc.failKey(map[key], key, "key '" + key + "' has value '" + text + "': file " + p.string() + " not found");
   }
   return p;
@@ -163,7 +163,7 @@ fs::path resolveVehicle(const fs::path& mjcf, const fs::path& vehicle_yaml) {
 fs::path descriptionBeside(const fs::path& mjcf) {
   fs::path yaml = mjcf;
   yaml.replace_extension(".yaml");
-  return fs::is_regular_file(yaml) ? yaml : fs::path();
+  return isRegularFile(yaml) ? yaml : fs::path();
 }
 
 }  // namespace tgnav::harness

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/base/shell.h"
 #include "harness/config/scenario.h"
 #include "harness/config/yaml_util.h"
@@ -107,7 +108,7 @@ std::string settingValue(const YamlDoc& doc, const std::string& key, const YAML:
   const std::string text = valueText(value);
   if (key != "vehicle") return text;
   const fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
-  if (!fs::is_regular_file(p)) doc.fail(value, "vehicle: file " + p.string() + " not found");
+  if (!isRegularFile(p)) doc.fail(value, "vehicle: file " + p.string() + " not found");
   return p.string();
 }
 
@@ -204,7 +205,7 @@ std::vector<fs::path> readScenarios(const YamlDoc& doc, const YAML::Node& run, c
   std::vector<fs::path> scenarios;
   for (const YAML::Node& s : oneOrList(doc, run, "scenario", context)) {
     const fs::path p = fs::absolute(source.parent_path() / s.Scalar()).lexically_normal();
-    if (!fs::is_regular_file(p)) {
+    if (!isRegularFile(p)) {
       doc.fail(s, joinKey(context, "scenario") + ": '" + s.Scalar() + "': file " + p.string() + " not found");
     }
     scenarios.push_back(p);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/config/yaml_util.h"
 #include "harness/io/text_fields.h"
 
@@ -165,7 +166,7 @@ planner::OccupancyGrid2D loadRosMap(const std::filesystem::path& yaml) {
 
   std::filesystem::path image = doc.string(root, "image", "");
   if (image.is_relative()) image = yaml.parent_path() / image;
-  if (!std::filesystem::is_regular_file(image)) {
+  if (!isRegularFile(image)) {
     bad("image", "an existing PGM file (looked for " + image.string() + ")");
   }
   const Pgm pgm = readPgm(image);

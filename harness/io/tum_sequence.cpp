@@ -50,7 +50,7 @@ struct ListEntry {
 // rgb.txt / depth.txt: "timestamp filename" lines, strictly increasing timestamps.
 std::vector<ListEntry> readList(const fs::path& dir, const std::string& name) {
   const fs::path file = dir / name;
-  if (!fs::is_regular_file(file)) {
+  if (!isRegularFile(file)) {
     throw InputError(file.string() +
                      ": missing (a TUM RGB-D sequence folder holds rgb.txt, depth.txt, rgb/ and depth/)");
   }
@@ -178,7 +178,7 @@ void readIntrinsics(const fs::path& file, Sequence& seq) {
 
 cv::Mat readImage(const fs::path& image, const fs::path& list, int line) {
   const std::string where = image.string() + " (" + list.filename().string() + ":" + std::to_string(line) + ")";
-  if (!fs::is_regular_file(image)) throw InputError(where + ": no such image file");
+  if (!isRegularFile(image)) throw InputError(where + ": no such image file");
   cv::Mat m;
   try {
     m = cv::imread(image.string(), cv::IMREAD_UNCHANGED);
@@ -316,10 +316,10 @@ Sequence loadSequence(const fs::path& dir) {
     e.depth = depth[j].file;
     e.rgb_line = rgb[i].line;
     e.depth_line = depth[j].line;
-    if (!fs::is_regular_file(e.rgb)) {
+    if (!isRegularFile(e.rgb)) {
       throw InputError(e.rgb.string() + " (rgb.txt:" + std::to_string(e.rgb_line) + "): no such image file");
     }
-    if (!fs::is_regular_file(e.depth)) {
+    if (!isRegularFile(e.depth)) {
       throw InputError(e.depth.string() + " (depth.txt:" + std::to_string(e.depth_line) + "): no such image file");
     }
     seq.frames.push_back(e);

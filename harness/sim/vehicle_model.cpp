@@ -66,7 +66,7 @@ std::string composeVehicleScene(const fs::path& mjcf, const VehicleDescription& 
 }
 
 VehicleModel loadVehicleModel(const fs::path& mjcf, const fs::path& vehicle_yaml) {
-  if (!fs::is_regular_file(mjcf)) throw InputError(mjcf.string() + ": MJCF file not found");
+  if (!isRegularFile(mjcf)) throw InputError(mjcf.string() + ": MJCF file not found");
   // A scene with no vehicle: what is wrong with its MJCF comes first, then that it has none.
   if (vehicle_yaml.empty() && includedVehicle(mjcf).empty()) loadModel(mjcf);
   const fs::path yaml = resolveVehicle(mjcf, vehicle_yaml);
