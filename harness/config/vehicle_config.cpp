@@ -17,7 +17,7 @@ bool supportedRotorCount(std::size_t n) { return n == 4 || n == 6 || n == 8; }
 namespace {
 
 std::string name(const YamlDoc& doc, const YAML::Node& map, const std::string& key, const std::string& context) {
-  const std::string value = doc.string(map, key, context);
+  std::string value = doc.string(map, key, context);
   if (value.empty()) doc.failKey(map[key], joinKey(context, key), "key '" + joinKey(context, key) + "' is empty");
   return value;
 }
@@ -35,7 +35,7 @@ double positive(const YamlDoc& doc, const YAML::Node& map, const std::string& ke
 
 fs::path existing(const YamlDoc& doc, const YAML::Node& map, const std::string& key) {
   const std::string text = name(doc, map, key, "");
-  const fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
+  fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
   if (!isRegularFile(p)) {
     doc.failKey(map[key], key, "key '" + key + "' has value '" + text + "': file " + p.string() + " not found");
   }
@@ -142,7 +142,7 @@ std::optional<IncludeRef> vehicleInclude(const fs::path& mjcf, const std::string
 }
 
 fs::path includedVehicle(const fs::path& mjcf) {
-  const fs::path own = descriptionBeside(mjcf);
+  fs::path own = descriptionBeside(mjcf);
   if (!own.empty()) return own;
   fs::path description;
   vehicleInclude(mjcf, readTextFile(mjcf), &description);
@@ -151,7 +151,7 @@ fs::path includedVehicle(const fs::path& mjcf) {
 
 fs::path resolveVehicle(const fs::path& mjcf, const fs::path& vehicle_yaml) {
   if (!vehicle_yaml.empty()) return vehicle_yaml;
-  const fs::path included = includedVehicle(mjcf);
+  fs::path included = includedVehicle(mjcf);
   if (included.empty()) {
     throw InputError(mjcf.string() +
                      ": includes no vehicle (an MJCF with a vehicle description .yaml beside it, such as "
