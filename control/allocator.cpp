@@ -16,16 +16,9 @@ constexpr double kEps = 1e-9;
 ControlAllocator::ControlAllocator(const VehicleParams& vehicle) {
   vehicle.validate();
   const int n = static_cast<int>(vehicle.rotors.size());
-  effectiveness_.resize(4, n);
+  effectiveness_ = vehicle.effectiveness();
   max_thrust_n_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    const Rotor& r = vehicle.rotors[i];
-    const Eigen::Vector3d force = r.axis_B * r.max_thrust_n;
-    // Thrust moment p x F, plus the rotor drag reaction (-spin along the axis).
-    const Eigen::Vector3d moment = r.p_B.cross(force) - r.spin * r.yaw_moment_ratio_m * force;
-    effectiveness_.col(i) << moment, force.z();
-    max_thrust_n_[i] = r.max_thrust_n;
-  }
+  for (int i = 0; i < n; ++i) max_thrust_n_[i] = vehicle.rotors[i].max_thrust_n;
   const Eigen::MatrixXd pinv = effectiveness_.completeOrthogonalDecomposition().pseudoInverse();  // n x 4
 
   // PX4's normalisation: a full roll or pitch demand spans about +-1/sqrt(2) of the motor range

@@ -28,13 +28,14 @@ void VehicleParams::validate() const {
   require(hoverThrust() < 0.9, "hover thrust (of maximum)", hoverThrust(), "vehicle too heavy to fly");
 }
 
-Eigen::MatrixXd VehicleParams::effectivenessPerNewton() const {
+Eigen::MatrixXd VehicleParams::effectiveness() const {
   Eigen::MatrixXd e(4, static_cast<Eigen::Index>(rotors.size()));
   for (std::size_t i = 0; i < rotors.size(); ++i) {
     const Rotor& r = rotors[i];
+    const Eigen::Vector3d force = r.axis_B * r.max_thrust_n;
     // Thrust moment p x F, plus the rotor drag reaction (-spin along the axis).
-    const Eigen::Vector3d moment = r.p_B.cross(r.axis_B) - r.spin * r.yaw_moment_ratio_m * r.axis_B;
-    e.col(static_cast<Eigen::Index>(i)) << moment, r.axis_B.z();
+    const Eigen::Vector3d moment = r.p_B.cross(force) - r.spin * r.yaw_moment_ratio_m * force;
+    e.col(static_cast<Eigen::Index>(i)) << moment, force.z();
   }
   return e;
 }
@@ -45,7 +46,7 @@ void VehicleParams::checkControllable() const {
       throw std::invalid_argument("rotors[" + std::to_string(i) + "].axis_B: thrust must point upward (z > 0)");
     }
   }
-  const Eigen::MatrixXd e = effectivenessPerNewton();
+  const Eigen::MatrixXd e = effectiveness();
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(e);
   qr.setThreshold(1e-6);
   if (qr.rank() < 4) {

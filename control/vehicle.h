@@ -25,8 +25,9 @@ struct VehicleParams {
   // Throws std::invalid_argument unless the rotors can command roll, pitch and yaw moments and
   // collective thrust independently (the effectiveness matrix has rank 4) and every rotor lifts.
   void checkControllable() const;
-  // The 4 x n wrench [Mx, My, Mz, Fz] per newton of each rotor's thrust.
-  Eigen::MatrixXd effectivenessPerNewton() const;
+  // The 4 x n effectiveness matrix: the wrench [Mx, My, Mz in N m about B's axes, Fz in N] of
+  // each rotor at its maximum thrust (what the allocation inverts).
+  Eigen::MatrixXd effectiveness() const;
   double totalMaxThrustN() const;
   // Normalised collective thrust that balances gravity when level.
   double hoverThrust() const;

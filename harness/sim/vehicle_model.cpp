@@ -67,18 +67,22 @@ std::string composeVehicleScene(const fs::path& mjcf, const VehicleDescription& 
 
 VehicleModel loadVehicleModel(const fs::path& mjcf, const fs::path& vehicle_yaml) {
   if (!isRegularFile(mjcf)) throw InputError(mjcf.string() + ": MJCF file not found");
-  // A scene with no vehicle: what is wrong with its MJCF comes first, then that it has none.
-  if (vehicle_yaml.empty() && includedVehicle(mjcf).empty()) loadModel(mjcf);
-  const fs::path yaml = resolveVehicle(mjcf, vehicle_yaml);
+  const fs::path included = includedVehicle(mjcf);
+  const fs::path yaml = vehicle_yaml.empty() ? included : vehicle_yaml;
+  if (yaml.empty()) {
+    // A scene with no vehicle: what is wrong with its MJCF comes first, then that it has none.
+    loadModel(mjcf);
+    resolveVehicle(mjcf, yaml);  // throws, saying how to name one
+  }
   VehicleModel out;
   out.vehicle = loadVehicleDescription(yaml);
-  const fs::path own = descriptionBeside(mjcf);
-  const fs::path included = own.empty() ? includedVehicle(mjcf) : own;
-  if (!included.empty() && sameFile(loadVehicleDescription(included).mjcf, out.vehicle.mjcf)) {
+  const bool as_written =
+      !included.empty() && (yaml == included || sameFile(loadVehicleDescription(included).mjcf, out.vehicle.mjcf));
+  if (as_written) {
     out.model = loadModel(mjcf);
-  } else if (!own.empty()) {
-    throw InputError(mjcf.string() + ": is itself a vehicle (" + own.string() + " beside it); it cannot be flown by " +
-                     yaml.string());
+  } else if (!descriptionBeside(mjcf).empty()) {
+    throw InputError(mjcf.string() + ": is itself a vehicle (" + descriptionBeside(mjcf).string() +
+                     " beside it); it cannot be flown by " + yaml.string());
   } else {
     out.model = compileText(mjcf, composeVehicleScene(mjcf, out.vehicle), "vehicle " + yaml.string());
   }

@@ -16,6 +16,19 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
+// The disturbed start of the hover tests: 10 deg of roll and drifting (0.3, -0.2, 0.1) m/s.
+void disturb(mjData* d, const VehicleIds& ids) {
+  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitX()));
+  mjtNum* q = d->qpos + ids.qpos_adr;
+  q[3] = tilted.w();
+  q[4] = tilted.x();
+  q[5] = tilted.y();
+  q[6] = tilted.z();
+  d->qvel[ids.qvel_adr] = 0.3;
+  d->qvel[ids.qvel_adr + 1] = -0.2;
+  d->qvel[ids.qvel_adr + 2] = 0.1;
+}
+
 class FlightTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -79,15 +92,7 @@ TEST_F(FlightTest, HoverHoldsWithin2cmFor20s) {
   // Start disturbed (10 deg roll, drifting, motors idle), recover for 5 s, then hold 20 s.
   const Eigen::Vector3d p(1.0, -2.0, 1.5);
   startHovering(p);
-  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitX()));
-  mjtNum* q = data_->qpos + ids_.qpos_adr;
-  q[3] = tilted.w();
-  q[4] = tilted.x();
-  q[5] = tilted.y();
-  q[6] = tilted.z();
-  data_->qvel[ids_.qvel_adr] = 0.3;
-  data_->qvel[ids_.qvel_adr + 1] = -0.2;
-  data_->qvel[ids_.qvel_adr + 2] = 0.1;
+  disturb(data_.get(), ids_);
   for (int i = 0; i < 4; ++i) data_->act[ids_.motor_act[i]] = 0.0;
   mj_forward(model_.get(), data_.get());
   fly(5.0, at(p));
@@ -211,16 +216,7 @@ TEST_P(AirframeFlight, HoverHoldsWithin2cmAfterADisturbedStart) {
   // As HoverHoldsWithin2cmFor20s: 10 deg roll, drifting, motors idle; recover 5 s, hold 20 s.
   const Eigen::Vector3d p(1.0, -2.0, 1.5);
   place(p);
-  const VehicleIds& ids = vehicle_.ids;
-  const Eigen::Quaterniond tilted(Eigen::AngleAxisd(10 * kDeg, Eigen::Vector3d::UnitX()));
-  mjtNum* q = data_->qpos + ids.qpos_adr;
-  q[3] = tilted.w();
-  q[4] = tilted.x();
-  q[5] = tilted.y();
-  q[6] = tilted.z();
-  data_->qvel[ids.qvel_adr] = 0.3;
-  data_->qvel[ids.qvel_adr + 1] = -0.2;
-  data_->qvel[ids.qvel_adr + 2] = 0.1;
+  disturb(data_.get(), vehicle_.ids);
   const control::VehicleParams& v = loop_->vehicle();
   const auto n = static_cast<Eigen::Index>(v.rotors.size());
   loop_->setMotorThrusts(Eigen::VectorXd::Zero(n));

@@ -125,7 +125,8 @@ TEST(VehicleModel, X2LikeDirectThrustMotorsTakeTheirLagAndTimestepFromTheDescrip
 
 TEST(Allocation, FollowsTheRotorGeometryOfTheMjcfWithoutCodeChanges) {
   const control::VehicleParams base = paramsOf(src("models/quadrotor.yaml"));
-  // Longer arms: every rotor twice as far out, so twice the roll and pitch moment per newton.
+  // Longer arms: every rotor twice as far out, so twice the roll and pitch moment per newton
+  // (the same thrust limits: twice per unit command too).
   std::vector<std::pair<std::string, std::string>> longer;
   for (const char* site : {"rotor0\" pos=\"0.177 -0.177", "rotor1\" pos=\"-0.177 0.177", "rotor2\" pos=\"0.177 0.177",
                            "rotor3\" pos=\"-0.177 -0.177"}) {
@@ -137,8 +138,8 @@ TEST(Allocation, FollowsTheRotorGeometryOfTheMjcfWithoutCodeChanges) {
     longer.emplace_back(s, to);
   }
   const control::VehicleParams wide = paramsOf(quadVariant(longer));
-  const Eigen::MatrixXd e0 = base.effectivenessPerNewton();
-  const Eigen::MatrixXd e1 = wide.effectivenessPerNewton();
+  const Eigen::MatrixXd e0 = base.effectiveness();
+  const Eigen::MatrixXd e1 = wide.effectiveness();
   EXPECT_TRUE(e1.topRows<2>().isApprox(2.0 * e0.topRows<2>(), 1e-9)) << e0 << "\n\n" << e1;
   EXPECT_TRUE(e1.bottomRows<2>().isApprox(e0.bottomRows<2>(), 1e-9));
 
