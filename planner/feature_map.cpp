@@ -153,7 +153,7 @@ void FeatureMap::save(const std::filesystem::path& dir) const {
   bt.close();
   if (!bt) fail(dir / "map.bt");
   std::ofstream out(dir / "landmarks.csv");
-  out << "id,x,y,z,observations,ref_x,ref_y,ref_z,voxel_x,voxel_y,voxel_z,descriptor\n";
+  out << "id,x,y,z,observations,opportunities,ref_x,ref_y,ref_z,voxel_x,voxel_y,voxel_z,descriptor\n";
   out.precision(6);
   out << std::fixed;
   static const char* kHex = "0123456789abcdef";
@@ -166,8 +166,8 @@ void FeatureMap::save(const std::filesystem::path& dir) const {
       hex += kHex[b & 15];
     }
     out << i << ',' << lm.p_W.x() << ',' << lm.p_W.y() << ',' << lm.p_W.z() << ',' << lm.observations << ','
-        << lm.ref_kf_p_W.x() << ',' << lm.ref_kf_p_W.y() << ',' << lm.ref_kf_p_W.z() << ',' << v.x() << ',' << v.y()
-        << ',' << v.z() << ',' << hex << '\n';
+        << lm.opportunities << ',' << lm.ref_kf_p_W.x() << ',' << lm.ref_kf_p_W.y() << ',' << lm.ref_kf_p_W.z() << ','
+        << v.x() << ',' << v.y() << ',' << v.z() << ',' << hex << '\n';
   }
   out.close();
   if (!out) fail(dir / "landmarks.csv");
@@ -196,20 +196,28 @@ FeatureMap FeatureMap::load(const std::filesystem::path& dir) {
     std::string field;
     std::vector<std::string> f;
     while (std::getline(ss, field, ',')) f.push_back(field);
-    if (f.size() != 12 || f[11].size() != 64) {
+    // 13 columns; 12 in maps saved before the opportunities column.
+    const std::size_t n = f.size();
+    if ((n != 12 && n != 13) || f[n - 1].size() != 64) {
       throw std::runtime_error(csv + ":" + std::to_string(line_no) +
-                               ": expected 12 columns with a 64-digit descriptor");
+                               ": expected 13 columns (12 without opportunities) with a 64-digit descriptor");
     }
+    const std::size_t extra = n - 12;  // the opportunities column shifts the ones after it
     Landmark lm;
     double v[10];
     try {
-      for (int k = 0; k < 10; ++k) v[k] = std::stod(f[k + 1]);
+      for (std::size_t k = 0; k < 4; ++k) v[k] = std::stod(f[k + 1]);
+      if (extra == 1) lm.opportunities = std::stoi(f[5]);
+      for (std::size_t k = 4; k < 10; ++k) v[k] = std::stod(f[k + 1 + extra]);
       for (int b = 0; b < 32; ++b) {
         lm.descriptor[b] =
-            static_cast<std::uint8_t>(std::stoi(f[11].substr(2 * static_cast<std::size_t>(b), 2), nullptr, 16));
+            static_cast<std::uint8_t>(std::stoi(f[n - 1].substr(2 * static_cast<std::size_t>(b), 2), nullptr, 16));
       }
     } catch (const std::exception&) {
       throw std::runtime_error(csv + ":" + std::to_string(line_no) + ": malformed number or descriptor");
+    }
+    if (lm.opportunities < 0) {
+      throw std::runtime_error(csv + ":" + std::to_string(line_no) + ": opportunities " + f[5] + " is negative");
     }
     lm.p_W = Eigen::Vector3d(v[0], v[1], v[2]);
     lm.observations = static_cast<int>(v[3]);

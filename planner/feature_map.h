@@ -5,6 +5,7 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -17,8 +18,19 @@ namespace tgnav::planner {
 struct Landmark {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  // mean of its observations
   int observations = 1;
+  // Survey frames that had it in view (in the image, in range, not occluded): its detections
+  // are observations out of that many chances. 0: unknown (a map from before it was counted).
+  int opportunities = 0;
   Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero();  // camera position that first saw it
   std::array<std::uint8_t, 32> descriptor{};             // ORB, from the reference observation
+
+  // The chance that a frame with it in view detects it again: observations / opportunities,
+  // measured over the survey (1 where the opportunities are unknown). A landmark on a strongly
+  // textured surface is found from nearly every view; one on a faint surface, found only where
+  // the noise-free survey render lifted a corner just over the detector's threshold, from few.
+  double detectability() const {
+    return opportunities > 0 ? std::min(1.0, static_cast<double>(observations) / opportunities) : 1.0;
+  }
 };
 
 // Sensing model of the query (V(p) uses range and vertical FoV; yaw filters by horizontal FoV).
@@ -72,7 +84,8 @@ class FeatureMap {
                                    const VisibilityConfig& config) const;
 
   // map.bt (OctoMap binary) and landmarks.csv in `dir`; load() throws std::runtime_error naming
-  // the file on malformed input.
+  // the file on malformed input. load() also reads landmarks.csv without the opportunities
+  // column (maps saved before it: every landmark's detectability is then 1).
   void save(const std::filesystem::path& dir) const;
   static FeatureMap load(const std::filesystem::path& dir);
 

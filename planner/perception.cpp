@@ -17,6 +17,8 @@ void InformationConfig::validate() const {
           "must be finite and >= 0");
   require(min_image_coverage >= 0.0 && min_image_coverage <= 1.0, "min_image_coverage", min_image_coverage,
           "must be in [0, 1]");
+  require(min_detections >= 0.0 && std::isfinite(min_detections), "min_detections", min_detections,
+          "must be finite and >= 0");
 }
 
 double ViewSupport::coverage() const {
@@ -46,22 +48,25 @@ bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, con
 }
 
 double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config) {
-  const bool blind = support.landmarks < config.min_landmarks ||
+  const bool blind = support.landmarks < config.min_landmarks || support.detections < config.min_detections ||
                      (config.min_image_coverage > 0.0 && support.coverage() < config.min_image_coverage);
   return blind ? logDetInformation(Matrix6d::Zero(), config.epsilon) : logDetInformation(info, config.epsilon);
 }
 
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
-  std::map<int, int> count;
+  std::map<int, std::pair<int, double>> count;  // slot -> landmarks, detections
   for (int id : ids) {
     const int slot = voxels.landmarkSlot(id);
-    if (slot >= 0) ++count[slot];
+    if (slot < 0) continue;
+    auto& [n, detections] = count[slot];
+    ++n;
+    detections += voxels.detectability(id);
   }
   std::vector<WeightedPoint> points;
   points.reserve(count.size());
-  for (const auto& [slot, n] : count) {
+  for (const auto& [slot, sums] : count) {
     const LandmarkVoxel& v = voxels.landmarkVoxels()[static_cast<std::size_t>(slot)];
-    points.push_back({v.mean_W, static_cast<double>(n), v.normal_W});
+    points.push_back({v.mean_W, static_cast<double>(sums.first), v.normal_W, sums.second});
   }
   return points;
 }
@@ -84,7 +89,7 @@ Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::
   for (const WeightedPoint& pt : points) {
     if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
-      view.add(pt.weight, imageCell(p_W, yaw_rad, pt.p_W, visibility));
+      view.add(pt, imageCell(p_W, yaw_rad, pt.p_W, visibility));
     }
   }
   if (support != nullptr) *support = view;

@@ -37,6 +37,15 @@ struct InformationConfig {
   // of textured wall at the edge of a view filled by a plain wall held 600 map landmarks while the
   // VO found 80 features on it and was lost (generated room-1002). Calibrated against the VO.
   double min_image_coverage = 0.2;
+  // Expected detections (ours): a pose whose landmarks that count would give the VO fewer than
+  // this many detections scores as blind. A landmark is expected to be detected as often as the
+  // survey detected it when it had it in view (Landmark::detectability()). The map gathers every
+  // landmark any survey view detected, and the views detect each one from only some of the
+  // places that see it, so the landmark count overstates what one frame finds by an order of
+  // magnitude, and by more on surfaces whose corners few views detect. Calibrated against the VO
+  // (README: the perception model). The information itself stays the paper's: every landmark
+  // in view adds its bearing information (c_p keeps the scale of Table I's c_p,thr).
+  double min_detections = 50.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -46,6 +55,7 @@ struct InformationConfig {
     a("max_incidence_rad", max_incidence_rad);
     a("min_landmarks", min_landmarks);
     a("min_image_coverage", min_image_coverage);
+    a("min_detections", min_detections);
   }
 
   void validate() const;
@@ -55,6 +65,7 @@ struct WeightedPoint {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
   double weight = 1.0;                                 // number of landmarks at this point
   Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();  // their surface's outward normal; zero: unknown
+  double detections = 1.0;  // their summed Landmark::detectability(): what a view of them is expected to find
 };
 
 // True when a camera at p_W sees `point`'s surface within config.max_incidence_rad of its normal
@@ -68,10 +79,18 @@ constexpr int kImageRows = 6;
 // What backs a pose's information: the landmarks that count and the image cells they fall in.
 struct ViewSupport {
   double landmarks = 0.0;   // their summed weight
+  double detections = 0.0;  // their summed detections
   std::uint64_t cells = 0;  // bit row * kImageCols + col: a landmark falls in that cell
-  void add(double weight, int cell) {
-    landmarks += weight;
+  void count(const WeightedPoint& point) {
+    landmarks += point.weight;
+    detections += point.detections;
+  }
+  void cover(int cell) {
     if (cell >= 0) cells |= std::uint64_t{1} << cell;
+  }
+  void add(const WeightedPoint& point, int cell) {
+    count(point);
+    cover(cell);
   }
   double coverage() const;  // share of the kImageCols x kImageRows cells marked
 };
@@ -82,11 +101,12 @@ int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d&
               const VisibilityConfig& visibility);
 
 // The score of a pose from its information and what backs it: log det (I + eps Id), or the blind
-// score 6 ln eps when fewer than config.min_landmarks count or they cover less of the image than
-// config.min_image_coverage.
+// score 6 ln eps when fewer than config.min_landmarks count, they promise fewer than
+// config.min_detections detections or they cover less of the image than config.min_image_coverage.
 double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config);
 
-// The candidate landmarks `ids` grouped by their voxel in `voxels`; ids outside its box are left out.
+// The candidate landmarks `ids` grouped by their voxel in `voxels` (weight: their number;
+// detections: their summed detectability); ids outside its box are left out.
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids);
 
 // True if a level camera at p_W looking along yaw_rad sees l_W within range and both FoVs.

@@ -228,12 +228,11 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
           if (!computed) addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
           computed = true;
           info[idx] += contribution;
-          support[idx].add(pt.weight, -1);
+          support[idx].count(pt);
         });
       }
       for (const WeightedPoint& pt : seen) {
-        forYawsHolding(pt,
-                       [&](std::size_t idx) { support[idx].add(0.0, imageCell(p, yaw_of[idx], pt.p_W, visibility)); });
+        forYawsHolding(pt, [&](std::size_t idx) { support[idx].cover(imageCell(p, yaw_of[idx], pt.p_W, visibility)); });
       }
       for (int k = 0; k < yaws; ++k) {
         const double score =

@@ -218,9 +218,9 @@ class CovisibilityScorer {
         ++j;
       } else {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
-        addCentredInformation(p2, l.mean_W, static_cast<double>(l.ids.size()), config_.information.bearing_noise_rad,
-                              &info);
-        support.add(static_cast<double>(l.ids.size()), -1);
+        const WeightedPoint point{l.mean_W, static_cast<double>(l.ids.size()), l.normal_W, l.detections};
+        addCentredInformation(p2, point.p_W, point.weight, config_.information.bearing_noise_rad, &info);
+        support.count(point);
         ++i;
         ++j;
       }
@@ -228,8 +228,8 @@ class CovisibilityScorer {
     // The image coverage is the camera's at s2: all of its view, not only the common part.
     if (config_.information.min_image_coverage > 0.0) {
       for (int slot : b.slots) {
-        support.add(0.0, imageCell(p2, yaw2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W,
-                                   config_.visibility));
+        support.cover(
+            imageCell(p2, yaw2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W, config_.visibility));
       }
     }
     return scoreInformation(info, support, config_.information);

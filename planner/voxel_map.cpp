@@ -48,14 +48,18 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
     if (inside(c)) by_voxel[flat(c.x(), c.y(), c.z())].push_back(id);
   }
   landmark_slot_.assign(map.landmarks().size(), -1);
+  detectability_.reserve(map.landmarks().size());
+  for (const Landmark& lm : map.landmarks()) detectability_.push_back(lm.detectability());
   for (auto& [index, ids] : by_voxel) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double detections = 0.0;
     for (int id : ids) {
       sum += map.landmarks()[static_cast<std::size_t>(id)].p_W;
+      detections += detectability_[static_cast<std::size_t>(id)];
       landmark_slot_[static_cast<std::size_t>(id)] = static_cast<int>(landmark_voxels_.size());
     }
     const Eigen::Vector3d mean = sum / static_cast<double>(ids.size());
-    landmark_voxels_.push_back({index, centreOf(index), mean, surfaceNormal(index), std::move(ids)});
+    landmark_voxels_.push_back({index, centreOf(index), mean, surfaceNormal(index), std::move(ids), detections});
   }
   auto layer = [&](double z) {
     return static_cast<int>(std::clamp(std::floor((z - origin_.z()) / res_), -1.0, static_cast<double>(size_.z())));

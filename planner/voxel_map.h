@@ -26,7 +26,8 @@ struct LandmarkVoxel {
   // Outward surface normal: the mean direction to the free voxels within two voxels (unit; zero
   // where free space lies on opposite sides alike, e.g. a thin panel, or there is none).
   Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();
-  std::vector<int> ids;  // landmark ids, ascending
+  std::vector<int> ids;     // landmark ids, ascending
+  double detections = 0.0;  // sum of their Landmark::detectability(): what one view is expected to find
 };
 
 class VoxelMap {
@@ -47,6 +48,8 @@ class VoxelMap {
   const std::vector<LandmarkVoxel>& landmarkVoxels() const { return landmark_voxels_; }
   // Index into landmarkVoxels() of landmark `id` (-1: outside the box).
   int landmarkSlot(int id) const { return landmark_slot_.at(static_cast<std::size_t>(id)); }
+  // Landmark::detectability() of landmark `id`.
+  double detectability(int id) const { return detectability_.at(static_cast<std::size_t>(id)); }
 
   // V(p): landmarks within range and the vertical FoV of a camera at p (any yaw) whose voxel is
   // the first occupied voxel on the segment from p to its centre. Sorted ascending.
@@ -98,6 +101,7 @@ class VoxelMap {
   std::vector<int> site_;     // that obstacle voxel (padded flat index; -1: none within the band)
   std::vector<LandmarkVoxel> landmark_voxels_;
   std::vector<int> landmark_slot_;
+  std::vector<double> detectability_;
 };
 
 }  // namespace tgnav::planner

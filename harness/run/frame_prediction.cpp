@@ -17,6 +17,7 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   FramePrediction out;
   out.score = planner::scoreInformation(info, support, information);
   out.landmarks = static_cast<int>(support.landmarks);
+  out.detections = support.detections;
   out.coverage = support.coverage();
   return out;
 }

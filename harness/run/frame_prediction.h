@@ -12,8 +12,9 @@ namespace tgnav::harness {
 struct FramePrediction {
   double score =
       0.0;  // log det of the Fisher information of the landmarks in view (eq. 6, as the pose graph scores a node)
-  int landmarks = 0;      // map landmarks that count (in the field of view, range, line of sight and incidence limit)
-  double coverage = 0.0;  // share of the image's cells that hold one of them (planner::ViewSupport)
+  int landmarks = 0;        // map landmarks that count (in the field of view, range, line of sight and incidence limit)
+  double detections = 0.0;  // the detections they promise (planner::ViewSupport::detections)
+  double coverage = 0.0;    // share of the image's cells that hold one of them (planner::ViewSupport)
 };
 
 // The model at the true camera pose X_WC (optical frame: z forward): position and the yaw of the

@@ -26,6 +26,9 @@ using Clock = std::chrono::steady_clock;
 constexpr double kVehicleRadiusM = 0.3;
 // Survey frames rendered ahead of their integration (bounds the memory of a fast renderer).
 constexpr std::size_t kSurveyQueueFrames = 4;
+// Every survey frame's depth is kept at every kViewStridePx-th pixel (in millimetres) to count
+// each landmark's opportunities once all landmarks are known (9.6 MB per 1000 frames at 640x480).
+constexpr int kViewStridePx = 8;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // A landmark being accumulated over observations.
@@ -154,6 +157,56 @@ void observeFeatures(const RgbdFrame& frame, const Intrinsics& k, const MapBuild
   }
 }
 
+// A survey frame as the opportunity count needs it: where the camera was and its depth, sampled.
+struct SurveyView {
+  Eigen::Isometry3d X_CW;  // world to camera
+  cv::Mat depth_mm;        // CV_16UC1, pixel (r, c) = depth at image pixel (r, c) * kViewStridePx; 0 invalid
+};
+
+SurveyView keepView(const RgbdFrame& frame) {
+  SurveyView view{frame.X_WC.inverse(), cv::Mat()};
+  const cv::Mat& d = frame.depth_m;
+  view.depth_mm.create((d.rows + kViewStridePx - 1) / kViewStridePx, (d.cols + kViewStridePx - 1) / kViewStridePx,
+                       CV_16UC1);
+  for (int r = 0; r < view.depth_mm.rows; ++r) {
+    for (int c = 0; c < view.depth_mm.cols; ++c) {
+      const double z = d.at<float>(r * kViewStridePx, c * kViewStridePx);
+      view.depth_mm.at<std::uint16_t>(r, c) =
+          static_cast<std::uint16_t>(z > 0.0 ? std::min(65535.0, std::round(z * 1000.0)) : 0.0);
+    }
+  }
+  return view;
+}
+
+// True if `view` had p_W in its image (off the detector's border), within range and in front of
+// the surface its depth shows there (by 0.1 m + 2 % of the range: the landmark is a mean of
+// observations near that surface, and the sampled depth a pixel or a few away).
+bool hadInView(const SurveyView& view, const Eigen::Vector3d& p_W, const Intrinsics& k, const MapBuildConfig& config) {
+  const Eigen::Vector3d p_C = view.X_CW * p_W;
+  const double z = p_C.z();
+  if (z <= 0.0 || z > config.max_range_m) return false;
+  const double u = k.fx * p_C.x() / z + k.cx;
+  const double v = k.fy * p_C.y() / z + k.cy;
+  const double border = config.features.edge_threshold_px;
+  if (u < border || v < border || u > k.width_px - 1 - border || v > k.height_px - 1 - border) return false;
+  const int c = std::min(view.depth_mm.cols - 1, static_cast<int>(std::lround(u / kViewStridePx)));
+  const int r = std::min(view.depth_mm.rows - 1, static_cast<int>(std::lround(v / kViewStridePx)));
+  const double surface = 1e-3 * view.depth_mm.at<std::uint16_t>(r, c);
+  return surface > 0.0 && z <= surface + 0.1 + 0.02 * z;
+}
+
+// Landmark::opportunities: the survey frames that had each landmark in view. Deterministic: each
+// landmark's count is a sum over the frames in order.
+void countOpportunities(const std::vector<SurveyView>& views, const Intrinsics& k, const MapBuildConfig& config,
+                        std::vector<planner::Landmark>* landmarks) {
+  for (planner::Landmark& lm : *landmarks) {
+    int n = 0;
+    for (const SurveyView& view : views) n += hadInView(view, lm.p_W, k, config) ? 1 : 0;
+    // A frame may have detected it twice (two keypoints merged into it): never below the detections.
+    lm.opportunities = std::max(n, lm.observations);
+  }
+}
+
 // The merged landmarks seen at least `min_observations` times.
 std::vector<planner::Landmark> keptLandmarks(const LandmarkAssociator& associator, int min_observations,
                                              MapBuildStats* stats) {
@@ -229,6 +282,8 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   const vo::FeatureDetector detector(config.features);
   planner::FeatureMap map(config.resolution_m);
   LandmarkAssociator associator(config.merge_radius_m, config.max_hamming);
+  std::vector<SurveyView> views;
+  views.reserve(poses.size());
 
   // This thread renders the survey; a worker integrates the frames in order (depth into the
   // occupancy, keypoints into the landmark tracks) while the next ones render: the same map as one
@@ -239,6 +294,7 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
     stats.integrate_s += since(t0);
     t0 = Clock::now();
     observeFeatures(frame, k, config, detector, &associator, &stats);
+    views.push_back(keepView(frame));
     stats.features_s += since(t0);
   });
   for (std::size_t f = 0; f < poses.size(); ++f) {
@@ -252,10 +308,16 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   }
   integrator.finish();
 
-  map.setLandmarks(keptLandmarks(associator, config.min_observations, &stats));
+  std::vector<planner::Landmark> landmarks = keptLandmarks(associator, config.min_observations, &stats);
+  const Clock::time_point t_opportunities = Clock::now();
+  countOpportunities(views, k, config, &landmarks);
+  stats.opportunities_s = since(t_opportunities);
+  map.setLandmarks(std::move(landmarks));
   stats.landmarks_merged = static_cast<int>(associator.tracks().size());
   stats.dropped_not_embedded = map.embedLandmarks(config.max_shift_m);
   stats.landmarks = static_cast<int>(map.landmarks().size());
+  for (const planner::Landmark& lm : map.landmarks()) stats.mean_detectability += lm.detectability();
+  if (stats.landmarks > 0) stats.mean_detectability /= stats.landmarks;
   stats.total_s = since(t_start);
   if (stats_out != nullptr) *stats_out = stats;
   return map;

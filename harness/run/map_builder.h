@@ -1,7 +1,8 @@
 #pragma once
 // The mapping run (paper Sec. IV): render RGB-D from survey poses covering the free space,
 // integrate depth into an OctoMap by ray insertion, detect ORB features, back-project them into
-// world landmarks, merge repeated observations, and embed the landmarks in surface voxels.
+// world landmarks, merge repeated observations, count how many survey frames had each landmark in
+// view (its detectability: planner::Landmark), and embed the landmarks in surface voxels.
 #include <functional>
 #include <vector>
 
@@ -19,12 +20,14 @@ struct MapBuildStats {
   int landmarks_merged = 0;  // distinct landmarks after merging
   int dropped_few_observations = 0;
   int dropped_not_embedded = 0;
-  int landmarks = 0;  // in the final map
+  int landmarks = 0;                // in the final map
+  double mean_detectability = 0.0;  // their mean planner::Landmark::detectability()
   // Wall-clock seconds: rendering the survey (this thread), integrating its depth and keypoints
   // (a worker, overlapping the rendering), and the whole build.
   double render_s = 0.0;
   double integrate_s = 0.0;
   double features_s = 0.0;
+  double opportunities_s = 0.0;  // counting each landmark's opportunities over the survey (after it)
   double total_s = 0.0;
 };
 

@@ -37,8 +37,9 @@ class Fnv1a {
 // map holds for the same scene and settings (the feature detector, the landmark fusion, the
 // occupancy), or a cached map built by the old code would be taken for a new one. v2: ORB
 // keypoints at the coarse pyramid levels placed where they are (vo/features.cpp, 42d8b18); maps
-// cached before it differ from those a fresh clone builds.
-constexpr const char* kMapBuilderVersion = "tgnav-map-v2";
+// cached before it differ from those a fresh clone builds. v3: landmarks carry their survey
+// opportunities (planner::Landmark::detectability).
+constexpr const char* kMapBuilderVersion = "tgnav-map-v3";
 
 std::string settingsText(const SceneConfig& scene, const MapBuildConfig& c) {
   std::ostringstream s;

@@ -30,8 +30,12 @@ nlohmann::ordered_json summaryJson(const SceneConfig& scene, const MapBuildConfi
   j["dropped_few_observations"] = s.dropped_few_observations;
   j["dropped_not_embedded"] = s.dropped_not_embedded;
   j["landmarks"] = s.landmarks;
-  j["timing"] = {
-      {"render_s", s.render_s}, {"integrate_s", s.integrate_s}, {"features_s", s.features_s}, {"total_s", s.total_s}};
+  j["mean_detectability"] = s.mean_detectability;
+  j["timing"] = {{"render_s", s.render_s},
+                 {"integrate_s", s.integrate_s},
+                 {"features_s", s.features_s},
+                 {"opportunities_s", s.opportunities_s},
+                 {"total_s", s.total_s}};
   return j;
 }
 

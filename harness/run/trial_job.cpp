@@ -63,7 +63,8 @@ std::string voCsv(const TrialResult& r) {
   out.precision(6);
   out << std::fixed;
   out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
-         "predicted_score,predicted_landmarks,predicted_coverage,ba_correction_m,ba_correction_rad,ba_outliers,"
+         "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,ba_correction_m,ba_correction_"
+         "rad,ba_outliers,"
          "reason\n";
   for (const TrialFrame& f : r.frames) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
@@ -76,7 +77,8 @@ std::string voCsv(const TrialResult& r) {
     } else {
       out << ",,";
     }
-    out << ',' << f.predicted.score << ',' << f.predicted.landmarks << ',' << f.predicted.coverage << ',';
+    out << ',' << f.predicted.score << ',' << f.predicted.landmarks << ',' << f.predicted.coverage << ','
+        << f.predicted.detections << ',';
     if (std::isfinite(f.vo.ba_correction_m)) {  // keyframes that bundle adjustment refined
       out << f.vo.ba_correction_m << ',' << f.vo.ba_correction_rad << ',' << f.vo.ba_outliers;
     } else {

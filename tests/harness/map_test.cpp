@@ -146,6 +146,23 @@ TEST_F(SmokeMapTest, TexturedCratesCarryLandmarksThePlainPillarNone) {
   EXPECT_LT(pillar * 20, crate);
 }
 
+// Each landmark's detectability is its detections out of the survey frames that had it in view:
+// never more detections than chances, and the chances counted from the survey's own frames
+// (the survey has more views of every landmark than the two it takes to keep one).
+TEST_F(SmokeMapTest, EveryLandmarkWasInViewAtLeastAsOftenAsItWasDetected) {
+  int more_chances = 0;
+  for (const planner::Landmark& lm : map_->landmarks()) {
+    ASSERT_GE(lm.opportunities, lm.observations);
+    ASSERT_LE(lm.opportunities, stats_.frames);
+    more_chances += lm.opportunities > lm.observations ? 1 : 0;
+  }
+  std::cout << "[ figure   ] smoke map: mean detectability " << stats_.mean_detectability << " over "
+            << stats_.landmarks << " landmarks\n";
+  EXPECT_GT(more_chances, static_cast<int>(map_->landmarks().size()) / 2);
+  EXPECT_GT(stats_.mean_detectability, 0.05);
+  EXPECT_LT(stats_.mean_detectability, 1.0);
+}
+
 TEST_F(SmokeMapTest, FlightHeightSliceMatchesTheGeometry) {
   const double res = 0.1;
   const double z = scene_->flight_height_m;

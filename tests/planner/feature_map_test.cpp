@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 namespace tgnav::planner {
 namespace {
@@ -95,6 +99,56 @@ TEST_F(FeatureMapTest, SaveLoadRoundTrip) {
   ASSERT_EQ(back.landmarks().size(), map_.landmarks().size());
   EXPECT_EQ(back.visibleFrom({-2.0, 0.0, 1.0}, VisibilityConfig{}), (std::vector<int>{0, 1, 4}));
   EXPECT_DOUBLE_EQ(back.resolution(), kRes);
+}
+
+TEST_F(FeatureMapTest, OpportunitiesRoundTripAndOldMapsLoadWithout) {
+  std::vector<Landmark> lms = map_.landmarks();
+  lms[0].observations = 3;
+  lms[0].opportunities = 12;
+  FeatureMap with(kRes);
+  fillBox(with.occupancy(), {-0.1, -2.0, 0.0}, {0.1, 2.0, 2.5});
+  with.setLandmarks(lms);
+  with.embedLandmarks(0.15);
+  const auto dir = std::filesystem::temp_directory_path() / "tgnav_feature_map_opportunities";
+  std::filesystem::create_directories(dir);
+  with.save(dir);
+  const FeatureMap back = FeatureMap::load(dir);
+  EXPECT_EQ(back.landmarks()[0].opportunities, 12);
+  EXPECT_DOUBLE_EQ(back.landmarks()[0].detectability(), 0.25);
+  EXPECT_DOUBLE_EQ(back.landmarks()[1].detectability(), 1.0);  // never counted: unknown
+
+  // The same file without the opportunities column (a map saved before it): detectability 1.
+  std::ifstream in(dir / "landmarks.csv");
+  std::stringstream old;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, ',')) f.push_back(field);
+    f.erase(f.begin() + 5);
+    for (std::size_t k = 0; k < f.size(); ++k) old << (k ? "," : "") << f[k];
+    old << '\n';
+  }
+  in.close();
+  std::ofstream(dir / "landmarks.csv") << old.str();
+  const FeatureMap legacy = FeatureMap::load(dir);
+  ASSERT_EQ(legacy.landmarks().size(), back.landmarks().size());
+  EXPECT_EQ(legacy.landmarks()[0].observations, 3);
+  EXPECT_EQ(legacy.landmarks()[0].opportunities, 0);
+  EXPECT_DOUBLE_EQ(legacy.landmarks()[0].detectability(), 1.0);
+  EXPECT_EQ(legacy.landmarks()[0].p_W, back.landmarks()[0].p_W);
+  EXPECT_EQ(legacy.landmarks()[0].ref_kf_p_W, back.landmarks()[0].ref_kf_p_W);
+}
+
+TEST(Detectability, ObservationsOutOfOpportunitiesAtMostOne) {
+  Landmark lm;
+  lm.observations = 2;
+  EXPECT_DOUBLE_EQ(lm.detectability(), 1.0);  // unknown
+  lm.opportunities = 8;
+  EXPECT_DOUBLE_EQ(lm.detectability(), 0.25);
+  lm.opportunities = 1;  // two keypoints of one frame merged into it
+  EXPECT_DOUBLE_EQ(lm.detectability(), 1.0);
 }
 
 TEST(FeatureMapLoad, MissingFilesAreNamed) {

@@ -59,6 +59,31 @@ TEST(ImageCoverage, ANarrowTexturedStripScoresBlindAFullViewDoesNot) {
   EXPECT_DOUBLE_EQ(poseScore(o, 0.0, full, vis, info), blind);
 }
 
+// A faint wall: the same landmarks, each detected by one survey view in eight that had it in
+// view. The information is the paper's (every landmark in view counts), so both walls score
+// alike; min_detections counts the detections they promise, and only the faint wall falls short.
+TEST(Detectability, FewExpectedDetectionsScoreBlindWhateverTheLandmarkCount) {
+  const VisibilityConfig vis;
+  InformationConfig info;
+  info.min_image_coverage = 0.0;
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  const double half_width = 2.0 * std::tan(0.5 * vis.hfov_rad);
+  const std::vector<WeightedPoint> rich = wall(-0.99 * half_width, 0.99 * half_width, 0.3);
+  std::vector<WeightedPoint> faint = rich;
+  for (WeightedPoint& pt : faint) pt.detections = 0.125;
+  ViewSupport a, b;
+  poseInformation(o, 0.0, rich, vis, info, &a);
+  poseInformation(o, 0.0, faint, vis, info, &b);
+  EXPECT_DOUBLE_EQ(a.landmarks, b.landmarks);
+  EXPECT_DOUBLE_EQ(a.detections, a.landmarks);
+  EXPECT_NEAR(b.detections, 0.125 * a.detections, 1e-9);
+  EXPECT_DOUBLE_EQ(poseScore(o, 0.0, rich, vis, info), poseScore(o, 0.0, faint, vis, info));
+  info.min_detections = 0.5 * (a.detections + b.detections);
+  const double blind = 6.0 * std::log(info.epsilon);
+  EXPECT_GT(poseScore(o, 0.0, rich, vis, info), info.epsilon);
+  EXPECT_DOUBLE_EQ(poseScore(o, 0.0, faint, vis, info), blind);
+}
+
 TEST(Incidence, GrazingViewsDoNotCountWhereTheNormalIsKnown) {
   InformationConfig info;
   info.max_incidence_rad = M_PI / 3.0;
