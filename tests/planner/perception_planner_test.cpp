@@ -227,6 +227,7 @@ PerceptionPlannerConfig plannerConfig() {
   // The paper's perception model: these scenes test eq. 9, and their textured faces are a grid of
   // landmarks 0.1 m apart that covers part of the image only (ImageCoverage tests the limit).
   c.information.min_image_coverage = 0.0;
+  c.information.min_detections = 0.0;  // (Detectability tests that gate)
   c.graph.guard_start_turn = false;  // and the paper's free start yaw (StartTurnNeverSweepsABlindView tests the guard)
   return c;
 }

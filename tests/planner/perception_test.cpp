@@ -66,6 +66,7 @@ TEST(Detectability, FewExpectedDetectionsScoreBlindWhateverTheLandmarkCount) {
   const VisibilityConfig vis;
   InformationConfig info;
   info.min_image_coverage = 0.0;
+  info.min_detections = 0.0;
   const Eigen::Vector3d o = Eigen::Vector3d::Zero();
   const double half_width = 2.0 * std::tan(0.5 * vis.hfov_rad);
   const std::vector<WeightedPoint> rich = wall(-0.99 * half_width, 0.99 * half_width, 0.3);
