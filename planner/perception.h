@@ -42,7 +42,8 @@ struct InformationConfig {
   // survey detected it when it had it in view (Landmark::detectability()). The map gathers every
   // landmark any survey view detected, and the views detect each one from only some of the
   // places that see it, so the landmark count overstates what one frame finds by an order of
-  // magnitude, and by more on surfaces whose corners few views detect. Calibrated against the VO
+  // magnitude: where a view of a faint surface holds a few hundred landmarks, which looks ample, it
+  // promises a few dozen detections, fewer than the VO needs. Calibrated against the VO
   // (README: the perception model). The information itself stays the paper's: every landmark
   // in view adds its bearing information (c_p keeps the scale of Table I's c_p,thr).
   double min_detections = 50.0;
