@@ -53,6 +53,23 @@ double scoreInformation(const Matrix6d& info, const ViewSupport& support, const 
   return blind ? logDetInformation(Matrix6d::Zero(), config.epsilon) : logDetInformation(info, config.epsilon);
 }
 
+double gateShortfall(const ViewSupport& support, const InformationConfig& config) {
+  double least = 1.0;  // the smallest share of a gate's threshold reached
+  if (support.landmarks < config.min_landmarks) least = std::min(least, support.landmarks / config.min_landmarks);
+  if (support.detections < config.min_detections) {
+    least = std::min(least, support.detections / config.min_detections);
+  }
+  if (config.min_image_coverage > 0.0 && support.coverage() < config.min_image_coverage) {
+    least = std::min(least, support.coverage() / config.min_image_coverage);
+  }
+  return 1.0 - std::max(0.0, least);
+}
+
+double rankedScore(double score, const ViewSupport& support, const InformationConfig& config) {
+  const double blind = logDetInformation(Matrix6d::Zero(), config.epsilon);
+  return score - std::max(1.0, std::abs(blind)) * gateShortfall(support, config);
+}
+
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
   std::map<int, std::pair<int, double>> count;  // slot -> landmarks, detections
   for (int id : ids) {

@@ -106,6 +106,17 @@ int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d&
 // config.min_detections detections or they cover less of the image than config.min_image_coverage.
 double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config);
 
+// How far a pose falls short of its gates: 0 when it passes every gate of scoreInformation() (or
+// none is set), else 1 minus the smallest of landmarks / min_landmarks, detections /
+// min_detections and coverage / min_image_coverage over the gates it fails, in (0, 1].
+double gateShortfall(const ViewSupport& support, const InformationConfig& config);
+
+// The score a search ranks a pose by (ours): scoreInformation(), lowered by gateShortfall() times
+// |6 ln eps| for a pose its gates blind. Every gated pose scores the same 6 ln eps, so where every
+// candidate of a layer is gated the search would have no reason left to prefer the yaw that misses
+// the gates by least; this keeps that order, below every pose that passes.
+double rankedScore(double score, const ViewSupport& support, const InformationConfig& config);
+
 // The candidate landmarks `ids` grouped by their voxel in `voxels` (weight: their number;
 // detections: their summed detectability); ids outside its box are left out.
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids);

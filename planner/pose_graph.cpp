@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
+#include <tuple>
 
 #include "planner/check.h"
 
@@ -73,6 +75,8 @@ void PoseGraphConfig::validate() const {
   require(distance_weight >= 0.0, "distance_weight", distance_weight, "must be >= 0");
   require(perception_weight >= 0.0, "perception_weight", perception_weight, "must be >= 0");
   require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
+  require(between_checks >= 0 && between_checks <= 20, "between_checks", between_checks, "must be in [0, 20]");
+  require(max_between_rounds >= 1, "max_between_rounds", max_between_rounds, "must be >= 1");
 }
 
 DagPath shortestLayeredPath(const LayeredDag& dag) {
@@ -147,6 +151,19 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   dag.node_cost.resize(static_cast<std::size_t>(layers));
   dag.edges.resize(static_cast<std::size_t>(layers - 1));
   std::vector<std::vector<double>> scores(static_cast<std::size_t>(layers));
+  std::vector<std::vector<WeightedPoint>> layer_seen(static_cast<std::size_t>(layers));
+  // What the camera sees around a layer (V of its path point, any yaw): the image coverage of
+  // InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
+  const bool gate = information.min_image_coverage > 0.0;
+  static const std::vector<WeightedPoint> kNone;
+  auto segmentAt = [&](double s) {
+    int seg = 0;
+    while (seg + 1 < static_cast<int>(segments.size()) && segments[static_cast<std::size_t>(seg)].s_end_m < s) ++seg;
+    return seg;
+  };
+  auto pointsOf = [&](int seg) -> const std::vector<WeightedPoint>& {
+    return segment_points.empty() ? kNone : segment_points[static_cast<std::size_t>(seg)];
+  };
   result.layer_s.resize(static_cast<std::size_t>(layers));
   result.layer_segment.resize(static_cast<std::size_t>(layers));
   const int half_window = static_cast<int>(std::ceil(0.5 * visibility.hfov_rad / yaw_step)) + 1;
@@ -180,20 +197,14 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         candidates.push_back(centre + r * (std::cos(a) * e1 + std::sin(a) * e2));
       }
     }
-    int seg = 0;
-    while (seg + 1 < static_cast<int>(segments.size()) && segments[static_cast<std::size_t>(seg)].s_end_m < s) ++seg;
+    const int seg = segmentAt(s);
     result.layer_segment[static_cast<std::size_t>(j)] = seg;
-    static const std::vector<WeightedPoint> kNone;
-    const std::vector<WeightedPoint>& points =
-        segment_points.empty() ? kNone : segment_points[static_cast<std::size_t>(seg)];
+    const std::vector<WeightedPoint>& points = pointsOf(seg);
     auto& layer_positions = positions[static_cast<std::size_t>(j)];
     auto& layer_cost = dag.node_cost[static_cast<std::size_t>(j)];
     auto& layer_scores = scores[static_cast<std::size_t>(j)];
-    // What the camera sees around this layer (V of the path point, any yaw): the image coverage
-    // of InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
-    const bool gate = information.min_image_coverage > 0.0;
-    const std::vector<WeightedPoint> seen =
-        gate ? aggregateByVoxel(voxels, voxels.visibleFrom(centre, visibility)) : std::vector<WeightedPoint>{};
+    auto& seen = layer_seen[static_cast<std::size_t>(j)];
+    if (gate) seen = aggregateByVoxel(voxels, voxels.visibleFrom(centre, visibility));
     for (const Eigen::Vector3d& p : candidates) {
       if (voxels.clearance(p) < config.robot_radius_m) continue;
       layer_positions.push_back(p);
@@ -235,11 +246,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         forYawsHolding(pt, [&](std::size_t idx) { support[idx].cover(imageCell(p, yaw_of[idx], pt.p_W, visibility)); });
       }
       for (int k = 0; k < yaws; ++k) {
-        const double score =
-            scoreInformation(info[static_cast<std::size_t>(k)], support[static_cast<std::size_t>(k)], information);
+        const ViewSupport& backing = support[static_cast<std::size_t>(k)];
+        const double score = scoreInformation(info[static_cast<std::size_t>(k)], backing, information);
         const bool allowed = j != 0 || (free_start ? turn_ok[static_cast<std::size_t>(k)] : k == 0);
         layer_scores.push_back(score);
-        layer_cost.push_back(allowed ? -config.perception_weight * score / layers : kInf);
+        layer_cost.push_back(allowed ? -config.perception_weight * rankedScore(score, backing, information) / layers
+                                     : kInf);
       }
     }
     if (layer_positions.empty() && result.blocked_layer < 0) result.blocked_layer = j;
@@ -267,10 +279,70 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   }
   for (const auto& layer : dag.node_cost) result.nodes += static_cast<int>(layer.size());
 
-  const DagPath best = shortestLayeredPath(dag);
+  // Lazy checks of the moves between layers (PoseGraphConfig::between_checks).
+  const double blind = logDetInformation(Matrix6d::Zero(), information.epsilon);
+  auto isBlind = [&](double score) { return score <= blind + 1e-9; };
+  // The lowest ranked score of the views between node `from` of layer j and node `to` of layer
+  // j + 1 that score blind, or NaN when none does or an end is blind already.
+  auto checkMove = [&](int j, int from, int to) {
+    const auto ju = static_cast<std::size_t>(j);
+    const Eigen::Vector3d& pa = positions[ju][static_cast<std::size_t>(from / yaws)];
+    const Eigen::Vector3d& pb = positions[ju + 1][static_cast<std::size_t>(to / yaws)];
+    const double ya = yaw_of[static_cast<std::size_t>(from % yaws)];
+    const double turn = wrapAngle(yaw_of[static_cast<std::size_t>(to % yaws)] - ya);
+    const double ends = std::min(scores[ju][static_cast<std::size_t>(from)], scores[ju + 1][static_cast<std::size_t>(to)]);
+    double lowest = std::numeric_limits<double>::quiet_NaN();
+    if (isBlind(ends)) return lowest;
+    ++result.between_checked;
+    for (int i = 1; i <= config.between_checks; ++i) {
+      const double f = static_cast<double>(i) / (config.between_checks + 1);
+      const Eigen::Vector3d p = (1.0 - f) * pa + f * pb;
+      const double yaw = wrapAngle(ya + f * turn);
+      const double s = (1.0 - f) * result.layer_s[ju] + f * result.layer_s[ju + 1];
+      ViewSupport backing;
+      const Matrix6d info = poseInformation(p, yaw, pointsOf(segmentAt(s)), visibility, information, &backing);
+      if (gate) {
+        backing.cells = 0;
+        for (const WeightedPoint& pt : layer_seen[2 * i <= config.between_checks + 1 ? ju : ju + 1]) {
+          if (inFieldOfView(p, yaw, pt.p_W, visibility) && withinIncidence(p, pt, information)) {
+            backing.cover(imageCell(p, yaw, pt.p_W, visibility));
+          }
+        }
+      }
+      const double score = scoreInformation(info, backing, information);
+      if (!isBlind(score)) continue;
+      const double ranked = rankedScore(score, backing, information);
+      if (!(ranked >= lowest)) lowest = ranked;  // also replaces NaN
+    }
+    return lowest;
+  };
+  std::map<std::tuple<int, int, int>, double> checked;  // (layer, from, to) -> checkMove()
+  DagPath best = shortestLayeredPath(dag);
+  result.between_rounds = 1;
+  while (config.between_checks > 0 && best.found) {
+    bool penalised = false;
+    for (int j = 0; j + 1 < layers; ++j) {
+      const int from = best.nodes[static_cast<std::size_t>(j)];
+      const int to = best.nodes[static_cast<std::size_t>(j) + 1];
+      const auto key = std::make_tuple(j, from, to);
+      if (checked.count(key) > 0) continue;
+      const double lowest = checkMove(j, from, to);
+      checked[key] = lowest;
+      if (std::isnan(lowest)) continue;
+      // The move costs what it would if its lower end were its blindest view.
+      const double ends = std::min(scores[static_cast<std::size_t>(j)][static_cast<std::size_t>(from)],
+                                   scores[static_cast<std::size_t>(j) + 1][static_cast<std::size_t>(to)]);
+      for (LayeredDag::Edge& e : dag.edges[static_cast<std::size_t>(j)]) {
+        if (e.from == from && e.to == to) e.cost += config.perception_weight * (ends - lowest) / layers;
+      }
+      penalised = true;
+    }
+    if (!penalised || result.between_rounds >= config.max_between_rounds) break;
+    best = shortestLayeredPath(dag);
+    ++result.between_rounds;
+  }
   if (!best.found) return result;
   result.found = true;
-  result.cost = best.cost;
   for (int j = 0; j < layers; ++j) {
     const int node = best.nodes[static_cast<std::size_t>(j)];
     const int k = node % yaws;
@@ -281,9 +353,27 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     result.path.push_back(pose);
     result.scores.push_back(scores[static_cast<std::size_t>(j)][static_cast<std::size_t>(node)]);
   }
+  // A move of the path that goes blind between two poses that pass: its lower end scores blind
+  // (a layer's pose stands for the path around it). Moves left unchecked by the round limit are
+  // checked here.
+  for (int j = 0; config.between_checks > 0 && j + 1 < layers; ++j) {
+    const int from = best.nodes[static_cast<std::size_t>(j)];
+    const int to = best.nodes[static_cast<std::size_t>(j) + 1];
+    const auto key = std::make_tuple(j, from, to);
+    const auto it = checked.find(key);
+    const double lowest = it != checked.end() ? it->second : checkMove(j, from, to);
+    if (std::isnan(lowest)) continue;
+    ++result.between_blind;
+    double& a = result.scores[static_cast<std::size_t>(j)];
+    double& b = result.scores[static_cast<std::size_t>(j) + 1];
+    (a <= b ? a : b) = blind;
+  }
   double sum = 0.0;
   for (double s : result.scores) sum += s;
   result.c_p = sum / layers;
+  // Eq. 7 of the path found, with its reported scores (the search ranked gated poses and blind
+  // moves below them, which is not part of the cost).
+  result.cost = config.distance_weight * result.c_d - config.perception_weight * result.c_p;
   return result;
 }
 

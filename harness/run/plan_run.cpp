@@ -156,7 +156,15 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
     cj["c_p_min"] = number(c.c_p_min);
     cj["blind_length_m"] = number(c.blind_length_m);
     cj["cost"] = number(c.cost);
-    if (i < run.plan.details.size()) cj["visibility_queries"] = run.plan.details[i].visibility_queries;
+    if (i < run.plan.details.size()) {
+      const planner::ClassDetail& d = run.plan.details[i];
+      cj["visibility_queries"] = d.visibility_queries;
+      cj["pose_graph"] = {{"nodes", d.graph.nodes},
+                          {"edges", d.graph.edges},
+                          {"rounds", d.graph.between_rounds},
+                          {"moves_checked", d.graph.between_checked},
+                          {"moves_blind", d.graph.between_blind}};
+    }
     cj["segments"] = nlohmann::json::array();
     for (const auto& seg : c.segments) {
       cj["segments"].push_back({{"s_begin_m", seg.s_begin_m},
