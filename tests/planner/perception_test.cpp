@@ -1,6 +1,7 @@
 // The perception model's trackability terms (planner/perception.h): where a landmark falls in the
 // image, the image coverage of a view, and the blind score below min_landmarks or
-// min_image_coverage; the incidence limit.
+// min_image_coverage; how far a pose falls short of its gates (the search's order among gated
+// poses); the incidence limit.
 #include "planner/perception.h"
 
 #include <gtest/gtest.h>
@@ -83,6 +84,41 @@ TEST(Detectability, FewExpectedDetectionsScoreBlindWhateverTheLandmarkCount) {
   const double blind = 6.0 * std::log(info.epsilon);
   EXPECT_GT(poseScore(o, 0.0, rich, vis, info), info.epsilon);
   EXPECT_DOUBLE_EQ(poseScore(o, 0.0, faint, vis, info), blind);
+}
+
+// Gated poses all score 6 ln eps; rankedScore() keeps them in order of how far they miss their
+// gates (the smallest share of a threshold reached), below every pose that passes.
+TEST(GateShortfall, RanksGatedPosesByTheGateTheyMissMostAndLeavesPassingOnesAlone) {
+  InformationConfig info;
+  info.min_image_coverage = 0.0;
+  info.min_detections = 0.0;
+  const double blind = 6.0 * std::log(info.epsilon);
+  ViewSupport none;
+  EXPECT_DOUBLE_EQ(gateShortfall(none, info), 0.0);  // no gate set: nothing to fall short of
+  EXPECT_DOUBLE_EQ(rankedScore(blind, none, info), blind);
+  ViewSupport some;
+  some.landmarks = 40.0;
+  some.detections = 10.0;
+  for (int cell = 0; cell < 12; ++cell) some.cover(cell);  // a quarter of the image
+  info.min_detections = 40.0;
+  EXPECT_DOUBLE_EQ(gateShortfall(some, info), 0.75);  // 10 of 40 detections
+  EXPECT_DOUBLE_EQ(rankedScore(blind, some, info), blind - 0.75 * std::abs(blind));
+  info.min_image_coverage = 0.5;  // a quarter of the image of half: detections still the worst
+  EXPECT_DOUBLE_EQ(gateShortfall(some, info), 0.75);
+  info.min_detections = 5.0;  // now the coverage alone fails, by half
+  EXPECT_DOUBLE_EQ(gateShortfall(some, info), 0.5);
+  info.min_landmarks = 80.0;  // and the landmarks, by half too
+  EXPECT_DOUBLE_EQ(gateShortfall(some, info), 0.5);
+  info.min_landmarks = 20.0;
+  info.min_image_coverage = 0.25;  // exactly at every threshold: passes
+  EXPECT_DOUBLE_EQ(gateShortfall(some, info), 0.0);
+  EXPECT_DOUBLE_EQ(rankedScore(3.5, some, info), 3.5);
+  // More detections rank higher among gated poses, and every gated one below 6 ln eps.
+  info.min_detections = 100.0;
+  ViewSupport more = some;
+  more.detections = 60.0;
+  EXPECT_GT(rankedScore(blind, more, info), rankedScore(blind, some, info));
+  EXPECT_LT(rankedScore(blind, more, info), blind);
 }
 
 TEST(Incidence, GrazingViewsDoNotCountWhereTheNormalIsKnown) {

@@ -1,7 +1,8 @@
 // 4-DoF pose graph (paper Sec. V-D): the layered-DAG dynamic programme against brute force,
 // and the pose graph search on a synthetic corridor (determinism, clearance, yaw-rate limit,
 // layer spacing, end points, perception pulling the yaw towards the textured wall, the straight
-// reference line without perception), plus config validation.
+// reference line without perception), the order kept among gated poses, the moves checked
+// between layers, plus config validation.
 #include "planner/pose_graph.h"
 
 #include <gtest/gtest.h>
@@ -445,6 +446,107 @@ TEST(PoseGraph, ImageCoverageGatesOnWhatTheCameraSees) {
             << " chosen poses gated blind\n";
 }
 
+// Where every pose is gated blind (here: the corridor's landmarks promise far fewer detections
+// than asked), every pose scores 6 ln eps, yet the search still prefers the views that miss the
+// gate by least: the yaw turns to the textured wall as it does with the gate off.
+TEST(PoseGraph, WhereEveryPoseIsGatedTheYawStillFacesTheTexture) {
+  for (int side : {+1, -1}) {
+    const Corridor& c = texturedCorridor(side);
+    const VisibilityConfig vis;
+    InformationConfig info = syntheticInformation();
+    info.min_detections = 5000.0;  // more than the corridor's 2000 landmarks
+    const std::vector<PathSegment> segments = extractSegments(
+        c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+    const PoseGraphConfig config;
+    const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, config, std::nan(""), 3);
+    expectFeasible(c, r, config);
+    const double blind = 6.0 * std::log(info.epsilon);
+    for (std::size_t j = 0; j < r.path.size(); ++j) EXPECT_DOUBLE_EQ(r.scores[j], blind) << "layer " << j;
+    EXPECT_EQ(r.between_checked, 0);  // a move between blind poses has nothing to lose
+    int towards = 0;
+    for (const Pose4& p : r.path) towards += side * std::sin(p.yaw_rad) > 0.2;
+    EXPECT_GE(towards, static_cast<int>(0.9 * static_cast<double>(r.path.size()))) << "side " << side;
+    std::cout << "[ figure   ] every pose gated, textured wall on side " << side << ": " << towards << "/"
+              << r.path.size() << " poses facing it\n";
+  }
+}
+
+// Two poses that pass the gates can have a blind stretch between them. A camera 1.5 m from a wall
+// looks at it (yaw pi/2) from x = 0 and x = 0.4: a narrow textured strip S1 sits at the left edge
+// of the first view, a denser one S2 at the right edge of the second, and the view halfway sees
+// neither. Turning 15 degrees left instead keeps S1 in view all the way, with less information
+// at the end than S2 would give. Without the checks the search takes S2 and flies blind between
+// the poses; with them it keeps S1; where it has no choice, the move's lower end is marked blind.
+TEST(PoseGraph, MovesThatGoBlindBetweenTheirPosesAreAvoidedOrMarked) {
+  const VisibilityConfig vis;
+  const double wall_y = 1.5;
+  const double w = wall_y * std::tan(0.5 * vis.hfov_rad);  // half width of a view on the wall
+  testing::SyntheticWorld world;
+  world.min_W = {-3.0, -1.0, 0.0};
+  world.max_W = {3.5, 2.0, 2.0};
+  const Eigen::AlignedBox3d s1(Eigen::Vector3d(-w + 0.02, wall_y, 0.0), Eigen::Vector3d(-w + 0.12, wall_y + 0.2, 2.0));
+  const Eigen::AlignedBox3d s2(Eigen::Vector3d(0.4 + w - 0.12, wall_y, 0.0),
+                               Eigen::Vector3d(0.4 + w - 0.02, wall_y + 0.2, 2.0));
+  world.solids = {s1, s2};
+  world.texture(s1, Eigen::Vector3d(0, -1, 0), 0.05);
+  world.texture(s2, Eigen::Vector3d(0, -1, 0), 0.025);
+  for (Landmark& lm : world.landmarks) lm.ref_kf_p_W = lm.p_W + 0.5 * (lm.ref_kf_p_W - lm.p_W);
+  const FeatureMap map = world.build();
+  const VoxelMap voxels(map, world.min_W, world.max_W);
+  const std::vector<Eigen::Vector3d> path{{0.0, 0.0, kZ}, {0.4, 0.0, kZ}};
+  PathSegment all;
+  all.s_end_m = 0.4;
+  all.p_begin = path.front();
+  all.p_end = path.back();
+  for (int id = 0; id < static_cast<int>(map.landmarks().size()); ++id) all.covisible.push_back(id);
+  InformationConfig info = syntheticInformation();
+  info.min_image_coverage = 0.0;
+  info.min_detections = 20.0;
+  const std::vector<WeightedPoint> points = aggregateByVoxel(voxels, all.covisible);
+  auto score = [&](double x, double yaw) { return poseScore({x, 0.0, kZ}, yaw, points, vis, info); };
+  const double blind = 6.0 * std::log(info.epsilon);
+  const double step = 2.0 * M_PI / PoseGraphConfig{}.yaw_samples;
+  ASSERT_GT(score(0.0, M_PI / 2), blind);         // S1
+  ASSERT_GT(score(0.4, M_PI / 2), blind);         // S2
+  ASSERT_DOUBLE_EQ(score(0.2, M_PI / 2), blind);  // neither
+  ASSERT_GT(score(0.4, M_PI / 2 + step), blind);  // S1, turned left
+  ASSERT_GT(score(0.2, M_PI / 2 + 0.5 * step), blind);
+  ASSERT_GT(score(0.4, M_PI / 2), score(0.4, M_PI / 2 + step));  // S2 is worth more
+
+  PoseGraphConfig config;
+  config.position_samples = 1;
+  config.between_checks = 0;  // the paper's search
+  const PoseGraphResult paper = searchPoseGraph(path, {all}, voxels, vis, info, config, M_PI / 2, 1);
+  ASSERT_TRUE(paper.found);
+  ASSERT_EQ(paper.path.size(), 2u);
+  EXPECT_NEAR(paper.path[1].yaw_rad, M_PI / 2, 1e-9);
+  EXPECT_EQ(paper.between_blind, 0);
+
+  config.between_checks = 3;
+  const PoseGraphResult checked = searchPoseGraph(path, {all}, voxels, vis, info, config, M_PI / 2, 1);
+  ASSERT_TRUE(checked.found);
+  EXPECT_NEAR(checked.path[1].yaw_rad, M_PI / 2 + step, 1e-9);
+  EXPECT_EQ(checked.between_blind, 0);
+  EXPECT_GE(checked.between_rounds, 2);
+  EXPECT_NEAR(checked.scores[1], score(0.4, M_PI / 2 + step), 1e-9);
+  EXPECT_NEAR(checked.cost, config.distance_weight * checked.c_d - config.perception_weight * checked.c_p, 1e-9);
+
+  // No choice (the yaw cannot turn): the blind move stays, and its lower end scores blind.
+  config.yaw_samples = 1;
+  const PoseGraphResult forced = searchPoseGraph(path, {all}, voxels, vis, info, config, M_PI / 2, 1);
+  ASSERT_TRUE(forced.found);
+  EXPECT_EQ(forced.between_blind, 1);
+  const double first = score(0.0, M_PI / 2);
+  const double last = score(0.4, M_PI / 2);
+  EXPECT_DOUBLE_EQ(forced.scores[first <= last ? 0 : 1], blind);
+  EXPECT_NEAR(forced.scores[first <= last ? 1 : 0], std::max(first, last), 1e-9);
+  EXPECT_NEAR(forced.c_p, 0.5 * (blind + std::max(first, last)), 1e-9);
+  std::cout << "[ figure   ] blind between two poses: paper's search ends at yaw " << paper.path[1].yaw_rad
+            << " (c_p " << paper.c_p << "), checked " << checked.path[1].yaw_rad << " (c_p " << checked.c_p << ", "
+            << checked.between_rounds << " rounds, " << checked.between_checked << " moves checked); forced c_p "
+            << forced.c_p << "\n";
+}
+
 TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;
@@ -513,6 +615,14 @@ TEST(PoseGraph, ConfigValidationNamesTheField) {
   c = PoseGraphConfig{};
   c.position_samples = 0;
   expectRejected(c, "position_samples");
+  c = PoseGraphConfig{};
+  c.between_checks = -1;
+  expectRejected(c, "between_checks");
+  c.between_checks = 21;
+  expectRejected(c, "between_checks");
+  c = PoseGraphConfig{};
+  c.max_between_rounds = 0;
+  expectRejected(c, "max_between_rounds");
 }
 
 }  // namespace
