@@ -290,7 +290,8 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     const Eigen::Vector3d& pb = positions[ju + 1][static_cast<std::size_t>(to / yaws)];
     const double ya = yaw_of[static_cast<std::size_t>(from % yaws)];
     const double turn = wrapAngle(yaw_of[static_cast<std::size_t>(to % yaws)] - ya);
-    const double ends = std::min(scores[ju][static_cast<std::size_t>(from)], scores[ju + 1][static_cast<std::size_t>(to)]);
+    const double ends =
+        std::min(scores[ju][static_cast<std::size_t>(from)], scores[ju + 1][static_cast<std::size_t>(to)]);
     double lowest = std::numeric_limits<double>::quiet_NaN();
     if (isBlind(ends)) return lowest;
     ++result.between_checked;

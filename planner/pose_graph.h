@@ -131,7 +131,7 @@ struct PoseGraphResult {
   double cost = 0.0;               // eq. 7 of `path` with `scores`
   int nodes = 0;
   int edges = 0;
-  int blocked_layer = -1;  // when not found: first layer without a collision-free node, if any
+  int blocked_layer = -1;   // when not found: first layer without a collision-free node, if any
   int between_checked = 0;  // moves scored between their layers (PoseGraphConfig::between_checks)
   int between_blind = 0;    // of them, moves that went blind between two poses that passed
   int between_rounds = 0;   // searches run

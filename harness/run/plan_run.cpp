@@ -125,6 +125,39 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
   return run;
 }
 
+namespace {
+
+// One class of plan.json: its candidate path and, for the proposed planner, how its pose graph went.
+nlohmann::ordered_json classJson(const planner::CandidatePath& c, const planner::ClassDetail* detail) {
+  nlohmann::ordered_json cj;
+  cj["h_signature"] = c.h_signature;
+  cj["feasible"] = c.feasible;
+  cj["length_m"] = c.length_m;
+  cj["c_p"] = number(c.c_p);
+  cj["c_p_min"] = number(c.c_p_min);
+  cj["blind_length_m"] = number(c.blind_length_m);
+  cj["cost"] = number(c.cost);
+  if (detail != nullptr) {
+    cj["visibility_queries"] = detail->visibility_queries;
+    cj["pose_graph"] = {{"nodes", detail->graph.nodes},
+                        {"edges", detail->graph.edges},
+                        {"rounds", detail->graph.between_rounds},
+                        {"moves_checked", detail->graph.between_checked},
+                        {"moves_blind", detail->graph.between_blind}};
+  }
+  cj["segments"] = nlohmann::json::array();
+  for (const auto& seg : c.segments) {
+    cj["segments"].push_back({{"s_begin_m", seg.s_begin_m},
+                              {"s_end_m", seg.s_end_m},
+                              {"covisible", seg.covisible},
+                              {"c_p", number(seg.c_p)}});
+  }
+  cj["waypoints"] = poseRows(c.path);
+  return cj;
+}
+
+}  // namespace
+
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   const planner::Plan& plan = run.plan;
   nlohmann::ordered_json j;
@@ -147,33 +180,7 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   j["topology_classes"] = run.plan.topo.classes.size();
   j["classes"] = nlohmann::json::array();
   for (std::size_t i = 0; i < plan.candidates.size(); ++i) {
-    const planner::CandidatePath& c = plan.candidates[i];
-    nlohmann::ordered_json cj;
-    cj["h_signature"] = c.h_signature;
-    cj["feasible"] = c.feasible;
-    cj["length_m"] = c.length_m;
-    cj["c_p"] = number(c.c_p);
-    cj["c_p_min"] = number(c.c_p_min);
-    cj["blind_length_m"] = number(c.blind_length_m);
-    cj["cost"] = number(c.cost);
-    if (i < run.plan.details.size()) {
-      const planner::ClassDetail& d = run.plan.details[i];
-      cj["visibility_queries"] = d.visibility_queries;
-      cj["pose_graph"] = {{"nodes", d.graph.nodes},
-                          {"edges", d.graph.edges},
-                          {"rounds", d.graph.between_rounds},
-                          {"moves_checked", d.graph.between_checked},
-                          {"moves_blind", d.graph.between_blind}};
-    }
-    cj["segments"] = nlohmann::json::array();
-    for (const auto& seg : c.segments) {
-      cj["segments"].push_back({{"s_begin_m", seg.s_begin_m},
-                                {"s_end_m", seg.s_end_m},
-                                {"covisible", seg.covisible},
-                                {"c_p", number(seg.c_p)}});
-    }
-    cj["waypoints"] = poseRows(c.path);
-    j["classes"].push_back(cj);
+    j["classes"].push_back(classJson(plan.candidates[i], i < plan.details.size() ? &plan.details[i] : nullptr));
   }
   j["chosen_class"] = plan.chosen >= 0 ? nlohmann::json(plan.chosen) : nlohmann::json(nullptr);
   j["chosen_topology_class"] =

@@ -541,8 +541,8 @@ TEST(PoseGraph, MovesThatGoBlindBetweenTheirPosesAreAvoidedOrMarked) {
   EXPECT_DOUBLE_EQ(forced.scores[first <= last ? 0 : 1], blind);
   EXPECT_NEAR(forced.scores[first <= last ? 1 : 0], std::max(first, last), 1e-9);
   EXPECT_NEAR(forced.c_p, 0.5 * (blind + std::max(first, last)), 1e-9);
-  std::cout << "[ figure   ] blind between two poses: paper's search ends at yaw " << paper.path[1].yaw_rad
-            << " (c_p " << paper.c_p << "), checked " << checked.path[1].yaw_rad << " (c_p " << checked.c_p << ", "
+  std::cout << "[ figure   ] blind between two poses: paper's search ends at yaw " << paper.path[1].yaw_rad << " (c_p "
+            << paper.c_p << "), checked " << checked.path[1].yaw_rad << " (c_p " << checked.c_p << ", "
             << checked.between_rounds << " rounds, " << checked.between_checked << " moves checked); forced c_p "
             << forced.c_p << "\n";
 }
