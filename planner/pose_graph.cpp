@@ -282,6 +282,11 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   // Lazy checks of the moves between layers (PoseGraphConfig::between_checks).
   const double blind = logDetInformation(Matrix6d::Zero(), information.epsilon);
   auto isBlind = [&](double score) { return score <= blind + 1e-9; };
+  // The lower score of a move's two ends.
+  auto lowerEnd = [&](int j, int from, int to) {
+    return std::min(scores[static_cast<std::size_t>(j)][static_cast<std::size_t>(from)],
+                    scores[static_cast<std::size_t>(j) + 1][static_cast<std::size_t>(to)]);
+  };
   // The lowest ranked score of the views between node `from` of layer j and node `to` of layer
   // j + 1 that score blind, or NaN when none does or an end is blind already.
   auto checkMove = [&](int j, int from, int to) {
@@ -290,10 +295,8 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     const Eigen::Vector3d& pb = positions[ju + 1][static_cast<std::size_t>(to / yaws)];
     const double ya = yaw_of[static_cast<std::size_t>(from % yaws)];
     const double turn = wrapAngle(yaw_of[static_cast<std::size_t>(to % yaws)] - ya);
-    const double ends =
-        std::min(scores[ju][static_cast<std::size_t>(from)], scores[ju + 1][static_cast<std::size_t>(to)]);
     double lowest = std::numeric_limits<double>::quiet_NaN();
-    if (isBlind(ends)) return lowest;
+    if (isBlind(lowerEnd(j, from, to))) return lowest;
     ++result.between_checked;
     for (int i = 1; i <= config.between_checks; ++i) {
       const double f = static_cast<double>(i) / (config.between_checks + 1);
@@ -331,10 +334,9 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       checked[key] = lowest;
       if (std::isnan(lowest)) continue;
       // The move costs what it would if its lower end were its blindest view.
-      const double ends = std::min(scores[static_cast<std::size_t>(j)][static_cast<std::size_t>(from)],
-                                   scores[static_cast<std::size_t>(j) + 1][static_cast<std::size_t>(to)]);
+      const double penalty = config.perception_weight * (lowerEnd(j, from, to) - lowest) / layers;
       for (LayeredDag::Edge& e : dag.edges[static_cast<std::size_t>(j)]) {
-        if (e.from == from && e.to == to) e.cost += config.perception_weight * (ends - lowest) / layers;
+        if (e.from == from && e.to == to) e.cost += penalty;
       }
       penalised = true;
     }
