@@ -493,8 +493,10 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFram
     obs.uv = Eigen::Vector2d(kp.pt.x, kp.pt.y);
     obs.depth_m = frame.valid[i] ? frame.p_C[i].z() : 0.0;
     obs.sigma_px = std::pow(sigma_step, std::max(0, kp.octave));
-    if (matched_landmark[i] >= 0) {  // tracked keypoints already have a landmark
-      obs.landmark = landmarks_[static_cast<std::size_t>(matched_landmark[i])].id;
+    if (matched_landmark[i] >= 0) {  // tracked: the landmark exists, and now belongs here
+      Landmark& lm = landmarks_[static_cast<std::size_t>(matched_landmark[i])];
+      obs.landmark = lm.id;
+      lm.keyframe = kf.id;
       kf.observations.push_back(obs);
       continue;
     }
@@ -512,8 +514,8 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFram
   }
   kf.tracked = tracked + created;
   keyframes_.push_back(kf);
-  // The local map: landmarks of the last local_map_keyframes keyframes. Those of the keyframe
-  // leaving it go too, unless they were matched in this frame (they then belong to the newest).
+  // The local map: landmarks observed by the last local_map_keyframes keyframes (a landmark
+  // belongs to the newest keyframe that observed it, and leaves the map with that keyframe).
   while (static_cast<int>(keyframes_.size()) > config_.local_map_keyframes) {
     const int gone = keyframes_.front().id;
     // It stays, fixed, in bundle adjustment's window for a while: its observations of the
@@ -521,9 +523,6 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFram
     retired_.push_back(std::move(keyframes_.front()));
     while (static_cast<int>(retired_.size()) > config_.ba.fixed_keyframes) retired_.pop_front();
     keyframes_.pop_front();
-    for (Landmark& lm : landmarks_) {
-      if (lm.keyframe == gone && lm.last_seen == frame_) lm.keyframe = kf.id;
-    }
     landmarks_.erase(
         std::remove_if(landmarks_.begin(), landmarks_.end(), [&](const Landmark& lm) { return lm.keyframe == gone; }),
         landmarks_.end());

@@ -29,8 +29,9 @@ namespace tgnav::vo {
 
 struct OdometryConfig {
   FeatureConfig features;
-  double min_depth_m = 0.2;  // features with depth outside this range have no 3D point
-  double max_depth_m = 8.0;
+  double min_depth_m = 0.2;          // features with depth outside this range have no 3D point
+  double max_depth_m = 10.0;         // a RealSense D435's range (configs/camera.yaml's): far points
+                                     // hold the rotation, and BA weighs their depth by its noise
   double depth_edge_m = 0.05;        // ... nor those on a depth discontinuity (3x3 spread above
                                      // this times the depth)
   int init_min_features = 100;       // features with depth needed to start (or restart)
@@ -153,7 +154,7 @@ class RgbdOdometry {
     Eigen::Vector3d p_W;
     std::array<std::uint64_t, 4> descriptor{};  // the 256-bit ORB descriptor
     int misses = 0;
-    int keyframe = 0;    // id of the keyframe it belongs to (created it, or last kept it)
+    int keyframe = 0;    // id of the newest keyframe that observed it (created or tracked it)
     long last_seen = 0;  // frame number it was created or last matched in
   };
   struct Observation {

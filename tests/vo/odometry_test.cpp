@@ -87,6 +87,37 @@ TEST(Odometry, BundleAdjustmentRefinesKeyframesOnly) {
   }
 }
 
+// The local map keeps a landmark while a keyframe in it observed the landmark, not only while
+// the keyframe that created it does. A still camera, a keyframe at every frame, a local map of
+// two keyframes: K0 sees the whole texture and creates its landmarks, K1 sees only the right
+// half (and tracks it), K2 only the left half. When K0 leaves the map at K2, the right half's
+// landmarks stay (K1 observed them), so the whole texture is tracked again at the next frame.
+TEST(Odometry, LandmarksStayWhileAKeyframeOfTheLocalMapObservedThem) {
+  const cv::Mat tex = texture(kW, kH);
+  const auto blanked = [&](int x0, int x1) {
+    cv::Mat image = tex.clone();
+    image(cv::Rect(x0, 0, x1 - x0, kH)).setTo(cv::Scalar(128));
+    return image;
+  };
+  OdometryConfig config;
+  config.local_map_keyframes = 2;
+  config.keyframe_inlier_ratio = 1.0;  // every frame that tracks fewer than its keyframe did
+  RgbdOdometry vo(camera(), config);
+  const FrameResult k0 = vo.track(0.0, tex, flatDepth());
+  const FrameResult k1 = vo.track(0.05, blanked(0, kW / 2), flatDepth());   // right half
+  const FrameResult k2 = vo.track(0.10, blanked(kW / 2, kW), flatDepth());  // left half
+  for (const FrameResult* r : {&k0, &k1, &k2}) {
+    ASSERT_NE(r->status, TrackingStatus::kLost) << r->reason;
+    EXPECT_TRUE(r->keyframe) << "t = " << r->t_s;
+  }
+  const FrameResult whole = vo.track(0.15, tex, flatDepth());
+  ASSERT_NE(whole.status, TrackingStatus::kLost) << whole.reason;
+  // Had they gone with K0, only the left half (and the few corners K1 and K2 created at the
+  // blank's edge) would match: about half.
+  EXPECT_GE(whole.inliers, 0.85 * k0.with_depth) << k1.inliers << " + " << k2.inliers << " of " << k0.with_depth;
+  EXPECT_LT(whole.X_WC.translation().norm(), 1e-3);
+}
+
 TEST(Odometry, BlankSaturatedOrDepthlessFramesAreLost) {
   const cv::Mat black(kH, kW, CV_8UC1, cv::Scalar(0));
   const cv::Mat white(kH, kW, CV_8UC3, cv::Scalar(255, 255, 255));
