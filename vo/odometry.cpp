@@ -456,7 +456,6 @@ bool RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatc
   for (std::size_t l = 0; l < landmarks_.size(); ++l) {
     if (seen[l]) {
       landmarks_[l].misses = 0;
-      landmarks_[l].last_seen = frame_;
     } else if (matches.expected[l]) {
       ++landmarks_[l].misses;
     }
@@ -508,7 +507,6 @@ void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFram
     lm.p_W = X_WC * frame.p_C[i];
     lm.descriptor = descriptorBits(frame.features.descriptors, static_cast<int>(i));
     lm.keyframe = kf.id;
-    lm.last_seen = frame_;
     landmarks_.push_back(std::move(lm));
     ++created;
   }

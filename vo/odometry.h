@@ -154,8 +154,7 @@ class RgbdOdometry {
     Eigen::Vector3d p_W;
     std::array<std::uint64_t, 4> descriptor{};  // the 256-bit ORB descriptor
     int misses = 0;
-    int keyframe = 0;    // id of the newest keyframe that observed it (created or tracked it)
-    long last_seen = 0;  // frame number it was created or last matched in
+    int keyframe = 0;  // id of the newest keyframe that observed it (created or tracked it)
   };
   struct Observation {
     long landmark = 0;  // Landmark::id
