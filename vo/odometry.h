@@ -30,8 +30,8 @@ namespace tgnav::vo {
 struct OdometryConfig {
   FeatureConfig features;
   double min_depth_m = 0.2;          // features with depth outside this range have no 3D point
-  double max_depth_m = 10.0;         // a RealSense D435's range (configs/camera.yaml's): far points
-                                     // hold the rotation, and BA weighs their depth by its noise
+  double max_depth_m = 10.0;         // the sensor's range (a RealSense D435's, configs/camera.yaml);
+                                     // BA weighs a far point's depth by its noise
   double depth_edge_m = 0.05;        // ... nor those on a depth discontinuity (3x3 spread above
                                      // this times the depth)
   int init_min_features = 100;       // features with depth needed to start (or restart)
