@@ -1,7 +1,6 @@
 #include "vo/odometry.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,6 +13,7 @@
 #include <utility>
 
 #include "vo/check.h"
+#include "vo/stage_clock.h"
 
 namespace tgnav::vo {
 
@@ -21,19 +21,12 @@ namespace {
 
 double rotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
 
-// Seconds since construction or the previous lap.
-class Stopwatch {
- public:
-  double lap() {
-    const auto now = std::chrono::steady_clock::now();
-    const double s = std::chrono::duration<double>(now - last_).count();
-    last_ = now;
-    return s;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
+// The time since the clock's previous lap, as a stage of `result` (wall and CPU seconds).
+void timeStage(StageClock& clock, double FrameResult::Timing::*stage, FrameResult* result) {
+  const StageClock::Lap lap = clock.lap();
+  result->timing.*stage = lap.wall_s;
+  result->cpu.*stage = lap.cpu_s;
+}
 
 // Keypoints bucketed on a coarse grid, for window searches around a predicted pixel.
 class KeypointGrid {
@@ -190,25 +183,26 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
     result.reason = msg.str();
     return record(result);
   }
-  Stopwatch clock;
+  StageClock clock;
   result.timing.features_s = frame.prepare_s;
+  result.cpu.features_s = frame.prepare_cpu_s;
   result.features = static_cast<int>(frame.features.keypoints.size());
   result.with_depth = frame.with_depth;
   if (!initialised_) {
     FrameResult first = initialise(result, frame);
-    first.timing.map_s = clock.lap();
+    timeStage(clock, &FrameResult::Timing::map_s, &first);
     return record(first);
   }
 
   const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
   const LocalMapMatches matches = matchLocalMap(frame, X_CW_pred);
-  result.timing.matching_s = clock.lap();
+  timeStage(clock, &FrameResult::Timing::matching_s, &result);
   result.matches = static_cast<int>(matches.object.size());
   if (result.matches < config_.min_inliers) {
     return lose(result, std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
   }
   const PoseEstimate pose = estimatePose(matches, X_CW_pred);
-  result.timing.pnp_s = clock.lap();
+  timeStage(clock, &FrameResult::Timing::pnp_s, &result);
   if (!pose.ransac_ok) {
     result.inliers = pose.ransac_inliers;
     return lose(result, std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
@@ -224,10 +218,10 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
   velocity_ = X_WC_.inverse() * X_WC;
   X_WC_ = X_WC;
   result.keyframe = updateLocalMap(frame, matches, pose);
-  result.timing.map_s = clock.lap();
+  timeStage(clock, &FrameResult::Timing::map_s, &result);
   if (result.keyframe && config_.ba.enabled) {
     adjustLocalMap(&result);
-    result.timing.ba_s = clock.lap();
+    timeStage(clock, &FrameResult::Timing::ba_s, &result);
   }
   result.X_WC = X_WC_;
   return record(result);
@@ -247,7 +241,7 @@ void RgbdOdometry::checkImages(const cv::Mat& image, const cv::Mat& depth_m) con
 
 RgbdOdometry::PreparedFrame RgbdOdometry::prepare(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const {
   checkImages(image, depth_m);
-  Stopwatch clock;
+  StageClock clock;
   PreparedFrame frame;
   frame.t_s = t_s;
   frame.features = detector_.detect(toGray(image));
@@ -259,7 +253,9 @@ RgbdOdometry::PreparedFrame RgbdOdometry::prepare(double t_s, const cv::Mat& ima
     frame.valid[i] = true;
     ++frame.with_depth;
   }
-  frame.prepare_s = clock.lap();
+  const StageClock::Lap lap = clock.lap();
+  frame.prepare_s = lap.wall_s;
+  frame.prepare_cpu_s = lap.cpu_s;
   return frame;
 }
 

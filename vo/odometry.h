@@ -104,9 +104,10 @@ struct FrameResult {
   double ba_correction_rad = std::numeric_limits<double>::quiet_NaN();
   int ba_outliers = 0;
   std::string reason;  // for lost frames: why (e.g. "12 inliers < 30")
-  // Wall-clock seconds of track()'s stages (not deterministic; never written to results that
-  // must repeat): ORB and back-projection, local-map matching, PnP (RANSAC and refinement),
-  // local-map upkeep (keyframe, landmarks), bundle adjustment.
+  // Seconds of track()'s stages (not deterministic; never written to results that must repeat):
+  // ORB and back-projection, local-map matching, PnP (RANSAC and refinement), local-map upkeep
+  // (keyframe, landmarks), bundle adjustment; on the wall clock (`timing`) and on the CPU clock of
+  // the thread that ran the stage (`cpu`).
   struct Timing {
     double features_s = 0.0;
     double matching_s = 0.0;
@@ -114,7 +115,9 @@ struct FrameResult {
     double map_s = 0.0;
     double ba_s = 0.0;
     double total() const { return features_s + matching_s + pnp_s + map_s + ba_s; }
-  } timing;
+  };
+  Timing timing;
+  Timing cpu;
 };
 
 class RgbdOdometry {
@@ -133,6 +136,7 @@ class RgbdOdometry {
     std::vector<bool> valid;           // depth in range and not on a discontinuity
     int with_depth = 0;                // valid ones
     double prepare_s = 0.0;            // wall-clock seconds it took (FrameResult::timing.features_s)
+    double prepare_cpu_s = 0.0;        // ... and CPU seconds of the thread that prepared it
   };
 
   // `image`: CV_8UC1 or CV_8UC3 (BGR); `depth_m`: CV_32FC1 metres along the optical axis, 0 or

@@ -11,6 +11,7 @@
 
 #include "control/state_estimator.h"
 #include "harness/base/errors.h"
+#include "harness/base/process.h"
 #include "harness/run/trial_metrics.h"
 #include "harness/run/vo_pipeline.h"
 #include "harness/sim/camera.h"
@@ -18,6 +19,7 @@
 #include "harness/sim/imu_sim.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/vehicle_model.h"
+#include "vo/stage_clock.h"
 
 namespace tgnav::harness {
 
@@ -121,18 +123,26 @@ class ClosedLoop {
     FlightHooks hooks;
     if (fly_on_vo_) hooks.control_state = [this](const FlightLoop&) { return estimator_.state(); };
     hooks.after_step = [this](const FlightLoop& l) { return afterStep(l); };
+    const double process_cpu0 = vo::processCpuSeconds();
+    const double renderer_cpu0 = threadsCpuSeconds("llvmpipe-");
     wall0_ = Clock::now();
     tick_mark_ = wall0_;
+    cpu_mark_ = vo::threadCpuSeconds();
     ticks_.emplace_back();  // frame 0, rendered before the clock started
     ticks_.back().rendered = true;
     result_->flight = flyTrajectory(loop_, trajectory_, cfg_.flight, hooks);
     // The physics after the last tick counts with it, and so does waiting for the VO to finish.
     const Clock::time_point flown = Clock::now();
     ticks_.back().sim_busy_s += seconds(flown - tick_mark_);
+    ticks_.back().sim_busy_cpu_s += vo::threadCpuSeconds() - cpu_mark_;
     std::vector<VoPipeline::Done> done = pipeline_->finish();
     const Clock::time_point end = Clock::now();
     ticks_.back().sim_wait_s += seconds(end - flown);
     result_->flight_wall_s = seconds(end - wall0_);
+    result_->profile.process_cpu_s = vo::processCpuSeconds() - process_cpu0;
+    const double renderer_cpu1 = threadsCpuSeconds("llvmpipe-");
+    result_->profile.renderer_cpu_s =
+        renderer_cpu0 >= 0.0 && renderer_cpu1 >= 0.0 ? renderer_cpu1 - renderer_cpu0 : -1.0;
     result_->sim_time_s = data_->time;
     collectFrames(std::move(done));
     fillProfile();
@@ -213,9 +223,12 @@ class ClosedLoop {
     }
     if (progress_) reportProgress(l);
     const Clock::time_point now = Clock::now();
+    const double cpu_now = vo::threadCpuSeconds();
     tick.sim_busy_s = seconds(now - tick_mark_) - blocked_s;
     tick.sim_wait_s = blocked_s;
+    tick.sim_busy_cpu_s = cpu_now - cpu_mark_;
     tick_mark_ = now;
+    cpu_mark_ = cpu_now;
     ticks_.push_back(tick);
   }
 
@@ -263,8 +276,14 @@ class ClosedLoop {
       TickProfile& tick = ticks_[k];
       tick.frame = done[k].frame_timing;
       tick.vo = done[k].vo.timing;
-      // Sequential: the simulation thread tracked the frame itself; that counts as the VO's.
-      if (!cfg_.pipeline) tick.sim_busy_s = std::max(0.0, tick.sim_busy_s - tick.featuresBusy() - tick.trackingBusy());
+      tick.frame_cpu = done[k].frame_cpu;
+      tick.vo_cpu = done[k].vo.cpu;
+      // Sequential: the simulation thread noised and tracked the frame itself; that counts as the VO's.
+      if (!cfg_.pipeline) {
+        tick.sim_busy_s = std::max(0.0, tick.sim_busy_s - tick.featuresBusy() - tick.trackingBusy());
+        const double vo_cpu = tick.frame_cpu.noise_s + tick.vo_cpu.total();
+        tick.sim_busy_cpu_s = std::max(0.0, tick.sim_busy_cpu_s - vo_cpu);
+      }
     }
     for (VoPipeline::Done& d : done) {
       const bool lost = d.vo.status == vo::TrackingStatus::kLost;
@@ -327,6 +346,7 @@ class ClosedLoop {
   const std::atomic<bool>* interrupt_ = nullptr;
   Clock::time_point wall0_;
   Clock::time_point tick_mark_;  // end of the last camera tick
+  double cpu_mark_ = 0.0;        // ... and the simulation thread's CPU seconds then
   std::vector<TickProfile> ticks_;
   long frame_index_ = 0;
   long fused_up_to_ = -1;

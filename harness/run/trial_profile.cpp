@@ -32,32 +32,83 @@ double TrialProfile::criticalPathSeconds() const {
   return std::max(sim, tracking_free);
 }
 
-nlohmann::ordered_json TrialProfile::toJson() const {
-  using nlohmann::ordered_json;
+namespace {
+
+// Per-stage totals over the ticks that rendered a frame.
+struct StageTotals {
   RgbdFrame::Timing frame;
   vo::FrameResult::Timing vo;
-  double sim_busy = 0.0, sim_wait = 0.0;
+  void add(const RgbdFrame::Timing& f, const vo::FrameResult::Timing& v) {
+    frame.render_s += f.render_s;
+    frame.readback_s += f.readback_s;
+    frame.convert_s += f.convert_s;
+    frame.noise_s += f.noise_s;
+    vo.features_s += v.features_s;
+    vo.matching_s += v.matching_s;
+    vo.pnp_s += v.pnp_s;
+    vo.map_s += v.map_s;
+    vo.ba_s += v.ba_s;
+  }
+  double rendering() const { return frame.render_s + frame.readback_s + frame.convert_s; }
+  double features() const { return frame.noise_s + vo.features_s; }  // the features stage
+  double tracking() const { return vo.total() - vo.features_s; }     // the tracking stage
+  // Each stage's seconds times `scale`, under the names of metrics.json.
+  nlohmann::ordered_json stages(double scale) const {
+    return {{"render", frame.render_s * scale},
+            {"readback", frame.readback_s * scale},
+            {"convert", frame.convert_s * scale},
+            {"noise", frame.noise_s * scale},
+            {"vo_features", vo.features_s * scale},
+            {"vo_matching", vo.matching_s * scale},
+            {"vo_pnp", vo.pnp_s * scale},
+            {"vo_map", vo.map_s * scale},
+            {"vo_ba", vo.ba_s * scale},
+            {"vo_total", vo.total() * scale}};
+  }
+};
+
+// CPU seconds per simulated second: what a stage costs whatever else shares the cores (the
+// figure that compares across machines). The simulation thread's physics, control, IMU,
+// estimator and checks are one figure (timing each physics step's CPU would cost more than the
+// step); llvmpipe draws on threads of its own; "other_threads" is the rest of the process
+// (OpenCV's pool, the progress display).
+nlohmann::ordered_json cpuPerSimSecond(const StageTotals& cpu, double sim_cpu_s, double process_cpu_s,
+                                       double renderer_cpu_s, double per_sim_s) {
+  nlohmann::ordered_json j = cpu.stages(per_sim_s);
+  j["simulation_thread"] = sim_cpu_s * per_sim_s;
+  j["physics_control_other"] = std::max(0.0, sim_cpu_s - cpu.rendering()) * per_sim_s;
+  j["features_thread"] = cpu.features() * per_sim_s;
+  j["tracking_thread"] = cpu.tracking() * per_sim_s;
+  const double threads = sim_cpu_s + cpu.features() + cpu.tracking();
+  if (renderer_cpu_s >= 0.0) {
+    j["renderer_threads"] = renderer_cpu_s * per_sim_s;
+    j["other_threads"] = std::max(0.0, process_cpu_s - threads - renderer_cpu_s) * per_sim_s;
+  } else {
+    j["renderer_threads"] = nullptr;
+    j["other_threads"] = nullptr;
+  }
+  j["process"] = process_cpu_s * per_sim_s;
+  return j;
+}
+
+}  // namespace
+
+nlohmann::ordered_json TrialProfile::toJson() const {
+  using nlohmann::ordered_json;
+  StageTotals wall, cpu;
+  double sim_busy = 0.0, sim_wait = 0.0, sim_cpu = 0.0;
   int rendered = 0;
   for (const TickProfile& t : ticks) {
     sim_busy += t.sim_busy_s;
     sim_wait += t.sim_wait_s;
+    sim_cpu += t.sim_busy_cpu_s;
     if (!t.rendered) continue;
     ++rendered;
-    frame.render_s += t.frame.render_s;
-    frame.readback_s += t.frame.readback_s;
-    frame.convert_s += t.frame.convert_s;
-    frame.noise_s += t.frame.noise_s;
-    vo.features_s += t.vo.features_s;
-    vo.matching_s += t.vo.matching_s;
-    vo.pnp_s += t.vo.pnp_s;
-    vo.map_s += t.vo.map_s;
-    vo.ba_s += t.vo.ba_s;
+    wall.add(t.frame, t.vo);
+    cpu.add(t.frame_cpu, t.vo_cpu);
   }
-  const double vo_busy = vo.total();
   const double per_frame = rendered > 0 ? 1e3 / rendered : 0.0;
-  const double per_sim_s = sim_time_s > 0.0 ? 1e3 / sim_time_s : 0.0;
-  const double rendering = frame.render_s + frame.readback_s + frame.convert_s;
-  const double camera = rendering + frame.noise_s;
+  const double per_sim_s = sim_time_s > 0.0 ? 1.0 / sim_time_s : 0.0;
   const double critical = criticalPathSeconds();
   ordered_json j;
   j["pipelined"] = pipelined;
@@ -67,31 +118,31 @@ nlohmann::ordered_json TrialProfile::toJson() const {
   j["opencv_threads"] = opencv_threads;
   j["camera_ticks"] = ticks.size();
   j["frames_processed"] = rendered;
-  j["per_frame_ms"] = {{"render", frame.render_s * per_frame},
-                       {"readback", frame.readback_s * per_frame},
-                       {"convert", frame.convert_s * per_frame},
-                       {"noise", frame.noise_s * per_frame},
-                       {"vo_features", vo.features_s * per_frame},
-                       {"vo_matching", vo.matching_s * per_frame},
-                       {"vo_pnp", vo.pnp_s * per_frame},
-                       {"vo_map", vo.map_s * per_frame},
-                       {"vo_ba", vo.ba_s * per_frame},
-                       {"vo_total", vo_busy * per_frame}};
-  j["per_sim_second_ms"] = {{"physics", physics_s * per_sim_s}, {"control", control_s * per_sim_s}};
+  j["per_frame_ms"] = wall.stages(per_frame);
+  j["per_sim_second_ms"] = {{"physics", physics_s * 1e3 * per_sim_s}, {"control", control_s * 1e3 * per_sim_s}};
+  j["cpu_per_sim_second_s"] = cpuPerSimSecond(cpu, sim_cpu, process_cpu_s, renderer_cpu_s, per_sim_s);
+  j["per_frame_cpu_ms"] = cpu.stages(per_frame);
   // The simulation thread's "other": IMU, estimator, contact checks, copying the state to render.
-  // Sequential, the features and the tracking run on it too (listed as their own stages).
+  // Sequential, the noise, the features and the tracking run on it too (listed as their own stages).
   ordered_json sim = {{"busy_s", sim_busy},
                       {"wait_vo_s", sim_wait},
+                      {"cpu_s", sim_cpu},
                       {"physics_s", physics_s},
                       {"control_s", control_s},
-                      {"render_s", rendering},
-                      {"noise_s", frame.noise_s},
-                      {"other_s", std::max(0.0, sim_busy - physics_s - control_s - camera)}};
-  const double tracking = vo_busy - vo.features_s;
+                      {"render_s", wall.rendering()},
+                      {"other_s", std::max(0.0, sim_busy - physics_s - control_s - wall.rendering())}};
+  const double features = wall.features();
+  const double tracking = wall.tracking();
   auto idle = [&](double busy) { return pipelined ? std::max(0.0, flight_wall_s - busy) : 0.0; };
-  ordered_json features_stage = {{"busy_s", vo.features_s}, {"idle_s", idle(vo.features_s)}};
-  ordered_json tracking_stage = {{"busy_s", tracking}, {"idle_s", idle(tracking)}, {"matching_s", vo.matching_s},
-                                 {"pnp_s", vo.pnp_s},  {"map_s", vo.map_s},        {"ba_s", vo.ba_s}};
+  ordered_json features_stage = {{"busy_s", features},
+                                 {"idle_s", idle(features)},
+                                 {"cpu_s", cpu.features()},
+                                 {"noise_s", wall.frame.noise_s},
+                                 {"orb_s", wall.vo.features_s}};
+  ordered_json tracking_stage = {{"busy_s", tracking},      {"idle_s", idle(tracking)},
+                                 {"cpu_s", cpu.tracking()}, {"matching_s", wall.vo.matching_s},
+                                 {"pnp_s", wall.vo.pnp_s},  {"map_s", wall.vo.map_s},
+                                 {"ba_s", wall.vo.ba_s}};
   if (pipelined) {
     j["threads"] = {{"simulation", sim}, {"features", features_stage}, {"tracking", tracking_stage}};
   } else {
@@ -99,10 +150,12 @@ nlohmann::ordered_json TrialProfile::toJson() const {
                     {"features_on_simulation_thread", features_stage},
                     {"tracking_on_simulation_thread", tracking_stage}};
   }
+  j["process_cpu_s"] = process_cpu_s;
+  j["renderer_threads_cpu_s"] = renderer_cpu_s >= 0.0 ? ordered_json(renderer_cpu_s) : ordered_json(nullptr);
   // The stage the flight waits on: the one busy for the longest.
   const char* bottleneck = "simulation";
-  if (vo.features_s > sim_busy && vo.features_s > tracking) bottleneck = "features";
-  if (tracking > sim_busy && tracking >= vo.features_s) bottleneck = "tracking";
+  if (features > sim_busy && features > tracking) bottleneck = "features";
+  if (tracking > sim_busy && tracking >= features) bottleneck = "tracking";
   j["bottleneck"] = pipelined ? bottleneck : "sequential";
   j["critical_path"] = {{"ms_per_tick", ticks.empty() ? 0.0 : 1e3 * critical / static_cast<double>(ticks.size())},
                         {"total_s", critical},

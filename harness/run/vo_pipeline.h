@@ -1,9 +1,9 @@
 #pragma once
 // The VO stage of a trial: camera noise, feature extraction, then tracking, frame after frame in
-// submission order. The noise is added on the submitting thread (the simulation's); threaded,
-// the features and the tracking each run on a worker (the simulation renders the next frames
-// meanwhile), otherwise inline. A frame's noise and result do not depend on the mode, so a
-// pipelined trial equals a sequential one.
+// submission order. Threaded, the noise and the features run on one worker and the tracking on
+// another (the simulation renders the next frames meanwhile), otherwise inline. The noise is
+// drawn frame after frame in order on either, so a frame's noise and result do not depend on the
+// mode: a pipelined trial equals a sequential one.
 #include <Eigen/Geometry>
 #include <atomic>
 #include <chrono>
@@ -26,11 +26,12 @@ class VoPipeline {
     vo::FrameResult vo;
     Eigen::Isometry3d X_WC_true;
     cv::Mat image;                   // the noised image, when asked to keep it (and at the first loss)
-    RgbdFrame::Timing frame_timing;  // rendering and noise (wall clock; vo.timing has tracking's)
+    RgbdFrame::Timing frame_timing;  // rendering and noise, wall clock (vo.timing: the VO's)
+    RgbdFrame::Timing frame_cpu;     // ... and CPU (vo.cpu: the VO's)
   };
 
-  // Threaded: one worker prepares the frames (ORB and back-projection, which do not depend on
-  // the odometry's state), another tracks them; each takes frames in order from a queue of
+  // Threaded: one worker prepares the frames (noise, ORB and back-projection, which do not depend
+  // on the odometry's state), another tracks them; each takes frames in order from a queue of
   // kQueueCapacity.
   VoPipeline(vo::RgbdOdometry& odometry, CameraNoise& noise, bool reinitialises, bool threaded)
       : odometry_(odometry), noise_(noise), reinitialises_(reinitialises) {
@@ -49,10 +50,9 @@ class VoPipeline {
   VoPipeline(VoPipeline&&) = delete;  // its workers capture `this`
   VoPipeline& operator=(VoPipeline&&) = delete;
 
-  // Adds the noise, then prepares and tracks the frame (inline) or queues it (threaded). Returns
-  // the seconds it waited for room in the queue.
+  // Noises, prepares and tracks the frame (inline) or queues it (threaded). Returns the seconds
+  // it waited for room in the queue.
   double submit(RgbdFrame frame, bool keep_image) {
-    noise_.apply(&frame);
     if (!preparer_) {
       track(prepare(Job{std::move(frame), keep_image}));
       return 0.0;
@@ -95,14 +95,16 @@ class VoPipeline {
     bool keep_image = false;
   };
 
-  Prepared prepare(Job job) const {
+  // Frames come here one at a time, in submission order: the noise's random stream stays in order.
+  Prepared prepare(Job job) {
+    noise_.apply(&job.frame);
     vo::RgbdOdometry::PreparedFrame prepared = odometry_.prepare(job.frame.t_s, job.frame.bgr, job.frame.depth_m);
     return Prepared{std::move(prepared), std::move(job.frame), job.keep_image};
   }
 
   void track(const Prepared& p) {
     const bool failed_before = odometry_.failed();
-    Done d{odometry_.track(p.vo), p.frame.X_WC, cv::Mat(), p.frame.timing};
+    Done d{odometry_.track(p.vo), p.frame.X_WC, cv::Mat(), p.frame.timing, p.frame.cpu};
     const bool first_loss = !failed_before && odometry_.failed();
     if (p.keep_image || first_loss) d.image = p.frame.bgr;
     if (odometry_.failed() && !reinitialises_) failed_for_good_.store(true);

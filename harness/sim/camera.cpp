@@ -1,12 +1,12 @@
 #include "harness/sim/camera.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
 #include "harness/base/errors.h"
+#include "vo/stage_clock.h"
 
 namespace tgnav::harness {
 
@@ -115,8 +115,7 @@ void Camera::hideVehicle() {
 }
 
 RgbdFrame Camera::renderNoiseless(mjData* d) {
-  using Clock = std::chrono::steady_clock;
-  const Clock::time_point t0 = Clock::now();
+  vo::StageClock clock;
   gl_.makeCurrent();
   const int w = config_.width_px;
   const int h = config_.height_px;
@@ -126,9 +125,9 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, w, h};
   mjr_render(viewport, &scene_, &context_);
-  const Clock::time_point t1 = Clock::now();
+  const vo::StageClock::Lap render = clock.lap();
   mjr_readPixels(rgb_buffer_.data(), depth_buffer_.data(), viewport, &context_);
-  const Clock::time_point t2 = Clock::now();
+  const vo::StageClock::Lap readback = clock.lap();
 
   RgbdFrame frame;
   frame.t_s = d->time;
@@ -149,10 +148,9 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
       depth[col] = (z >= min_depth && z <= max_depth) ? z : 0.0f;
     }
   }
-  const Clock::time_point t3 = Clock::now();
-  frame.timing.render_s = std::chrono::duration<double>(t1 - t0).count();
-  frame.timing.readback_s = std::chrono::duration<double>(t2 - t1).count();
-  frame.timing.convert_s = std::chrono::duration<double>(t3 - t2).count();
+  const vo::StageClock::Lap convert = clock.lap();
+  frame.timing = {render.wall_s, readback.wall_s, convert.wall_s, 0.0};
+  frame.cpu = {render.cpu_s, readback.cpu_s, convert.cpu_s, 0.0};
   return frame;
 }
 
@@ -167,7 +165,7 @@ CameraNoise::CameraNoise(const CameraConfig& config, std::uint64_t seed)
 }
 
 void CameraNoise::apply(RgbdFrame* frame) {
-  const auto t0 = std::chrono::steady_clock::now();
+  vo::StageClock clock;
   if (rgb_sigma_ > 0.0) {
     noise_.create(frame->bgr.size(), CV_32FC3);
     rng_.fill(noise_, cv::RNG::NORMAL, 0.0, rgb_sigma_);
@@ -192,7 +190,9 @@ void CameraNoise::apply(RgbdFrame* frame) {
       }
     }
   }
-  frame->timing.noise_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const vo::StageClock::Lap noise = clock.lap();
+  frame->timing.noise_s = noise.wall_s;
+  frame->cpu.noise_s = noise.cpu_s;
 }
 
 }  // namespace tgnav::harness

@@ -26,15 +26,19 @@ struct RgbdFrame {
   cv::Mat bgr;      // CV_8UC3, OpenCV channel order
   cv::Mat depth_m;  // CV_32FC1, z along the optical axis in metres; 0 = invalid
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
-  // Wall-clock seconds of making it (not deterministic): the scene update and the draw call,
-  // the framebuffer readback (RGB and depth in one call), the flip to top-down rows with depth
-  // linearisation; and the noise, added by whoever applies it.
+  // Seconds of making it (not deterministic): the scene update and the draw call, the
+  // framebuffer readback (RGB and depth in one call), the flip to top-down rows with depth
+  // linearisation; and the noise, added by whoever applies it. On the wall clock (`timing`) and
+  // on the CPU clock of the thread that did each (`cpu`; llvmpipe rasterises on threads of its
+  // own, which the readback waits for: their CPU is not in it).
   struct Timing {
     double render_s = 0.0;
     double readback_s = 0.0;
     double convert_s = 0.0;
     double noise_s = 0.0;
-  } timing;
+  };
+  Timing timing;
+  Timing cpu;
 };
 
 // The sensor noise of CameraConfig, seeded: Gaussian noise on every colour channel and depth

@@ -4,6 +4,12 @@
 #include "harness/run/trial_profile.h"
 
 #include <gtest/gtest.h>
+#include <pthread.h>
+
+#include <thread>
+
+#include "harness/base/process.h"
+#include "vo/stage_clock.h"
 
 namespace tgnav::harness {
 namespace {
@@ -73,11 +79,18 @@ TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
   p.sim_time_s = 0.2;
   p.physics_s = 0.004;
   p.control_s = 0.001;
+  p.process_cpu_s = 0.15;
+  p.renderer_cpu_s = 0.02;
   for (TickProfile& t : p.ticks) {
     t.frame.render_s = 0.002;
     t.frame.readback_s = 0.006;
-    t.frame.noise_s = 0.001;
     t.sim_wait_s = 0.0005;
+    t.sim_busy_cpu_s = 0.015;
+    t.frame_cpu.render_s = 0.001;
+    t.frame_cpu.readback_s = 0.002;
+    t.frame_cpu.noise_s = 0.001;
+    t.vo_cpu.features_s = 0.008;
+    t.vo_cpu.ba_s = 0.004;
   }
   const nlohmann::ordered_json j = p.toJson();
   EXPECT_EQ(j["camera_ticks"], 4);
@@ -89,9 +102,25 @@ TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
   EXPECT_NEAR(sim["busy_s"].get<double>(), 0.06, 1e-12);
   EXPECT_NEAR(sim["wait_vo_s"].get<double>(), 0.002, 1e-12);
   EXPECT_NEAR(sim["render_s"].get<double>(), 4 * 0.008, 1e-12);
-  EXPECT_NEAR(sim["other_s"].get<double>(), 0.06 - 0.004 - 0.001 - 4 * 0.009, 1e-12);
+  EXPECT_NEAR(sim["other_s"].get<double>(), 0.06 - 0.004 - 0.001 - 4 * 0.008, 1e-12);
+  EXPECT_NEAR(sim["cpu_s"].get<double>(), 4 * 0.015, 1e-12);
+  // CPU seconds per simulated second (0.2 s): per stage, per thread, llvmpipe's and the rest.
+  const auto& cpu = j["cpu_per_sim_second_s"];
+  EXPECT_NEAR(cpu["readback"].get<double>(), 4 * 0.002 / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["simulation_thread"].get<double>(), 4 * 0.015 / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["physics_control_other"].get<double>(), 4 * (0.015 - 0.003) / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["features_thread"].get<double>(), 4 * 0.009 / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["tracking_thread"].get<double>(), 4 * 0.004 / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["renderer_threads"].get<double>(), 0.02 / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["other_threads"].get<double>(), (0.15 - 4 * 0.028 - 0.02) / 0.2, 1e-9);
+  EXPECT_NEAR(cpu["process"].get<double>(), 0.15 / 0.2, 1e-9);
+  EXPECT_NEAR(j["per_frame_cpu_ms"]["vo_ba"].get<double>(), 4.0, 1e-9);
+  // Unknown renderer threads (no /proc): null, not a number that looks measured.
+  p.renderer_cpu_s = -1.0;
+  EXPECT_TRUE(p.toJson()["cpu_per_sim_second_s"]["renderer_threads"].is_null());
   EXPECT_NEAR(j["threads"]["features"]["busy_s"].get<double>(), 0.04, 1e-12);
   EXPECT_NEAR(j["threads"]["features"]["idle_s"].get<double>(), 0.03, 1e-12);
+  EXPECT_NEAR(j["threads"]["features"]["cpu_s"].get<double>(), 4 * 0.009, 1e-12);
   EXPECT_NEAR(j["threads"]["tracking"]["busy_s"].get<double>(), 0.0, 1e-12);
   EXPECT_EQ(j["bottleneck"], "simulation");
   EXPECT_NEAR(j["critical_path"]["total_s"].get<double>(), 3 * 0.02 + 0.01, 1e-12);
@@ -102,6 +131,31 @@ TEST(TrialProfile, JsonHasPerStageAndPerThreadTotals) {
   EXPECT_TRUE(s["threads"].contains("features_on_simulation_thread"));
   EXPECT_TRUE(s["threads"].contains("tracking_on_simulation_thread"));
   EXPECT_EQ(s["bottleneck"], "sequential");
+}
+
+// The CPU clocks behind the profile: a thread busy for 0.2 s of CPU is counted under its name
+// prefix and in the process's total; a stage that only waits costs its thread no CPU.
+TEST(TrialProfile, CpuClocksCountBusyThreadsNotWaiting) {
+  ASSERT_GE(threadsCpuSeconds("tgnav-busy"), 0.0) << "no /proc/self/task";
+  const double process0 = vo::processCpuSeconds();
+  double named_cpu = -1.0;
+  vo::StageClock waiting;
+  std::thread busy([&] {
+    pthread_setname_np(pthread_self(), "tgnav-busy-1");
+    const double cpu0 = vo::threadCpuSeconds();
+    volatile double x = 0.0;
+    while (vo::threadCpuSeconds() - cpu0 < 0.2) {
+      for (int i = 0; i < 10000; ++i) x = x + 1.0;
+    }
+    named_cpu = threadsCpuSeconds("tgnav-busy");  // while it still runs
+  });
+  busy.join();
+  const vo::StageClock::Lap wait = waiting.lap();
+  EXPECT_GE(wait.wall_s, 0.2);
+  EXPECT_LT(wait.cpu_s, 0.05);  // joining costs this thread (almost) nothing
+  EXPECT_GE(named_cpu, 0.19);
+  EXPECT_GE(vo::processCpuSeconds() - process0, 0.2);
+  EXPECT_EQ(threadsCpuSeconds("no-thread-has-this-name"), 0.0);
 }
 
 }  // namespace
