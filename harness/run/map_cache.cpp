@@ -38,8 +38,9 @@ class Fnv1a {
 // occupancy), or a cached map built by the old code would be taken for a new one. v2: ORB
 // keypoints at the coarse pyramid levels placed where they are (vo/features.cpp, 42d8b18); maps
 // cached before it differ from those a fresh clone builds. v3: landmarks carry their survey
-// opportunities (planner::Landmark::detectability).
-constexpr const char* kMapBuilderVersion = "tgnav-map-v3";
+// opportunities (planner::Landmark::detectability). v4: the survey's camera noise is drawn from
+// a quantile table (harness/sim/camera.h, CameraNoise), not by cv::RNG.
+constexpr const char* kMapBuilderVersion = "tgnav-map-v4";
 
 std::string settingsText(const SceneConfig& scene, const MapBuildConfig& c) {
   std::ostringstream s;

@@ -1,5 +1,6 @@
 #include "harness/sim/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <opencv2/core.hpp>
@@ -154,38 +155,115 @@ RgbdFrame Camera::renderNoiseless(mjData* d) {
   return frame;
 }
 
+namespace {
+
+// The standard normal quantile function: Acklam's rational approximation (relative error below
+// 1.2e-9), refined by one step of Halley's method on erfc to double precision.
+double normalQuantile(double p) {
+  static constexpr double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                                 1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static constexpr double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                                 6.680131188771972e+01, -1.328068155288572e+01};
+  static constexpr double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                                 -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static constexpr double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                                 3.754408661907416e+00};
+  constexpr double kLow = 0.02425;
+  double x = 0.0;
+  if (p < kLow || p > 1.0 - kLow) {
+    const double q = std::sqrt(-2.0 * std::log(p < kLow ? p : 1.0 - p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+    if (p > 1.0 - kLow) x = -x;
+  } else {
+    const double q = p - 0.5;
+    const double r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+  }
+  const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
+  const double u = e * std::sqrt(2.0 * M_PI) * std::exp(0.5 * x * x);
+  return x - u / (1.0 + 0.5 * x * u);
+}
+
+constexpr int kQuantileBits = 16;
+
+}  // namespace
+
+const std::vector<float>& normalQuantiles() {
+  static const std::vector<float> table = [] {
+    constexpr std::size_t n = std::size_t{1} << kQuantileBits;
+    std::vector<float> t(n);
+    for (std::size_t i = 0; i < n / 2; ++i) {  // symmetric: the upper half mirrors the lower
+      const auto z = static_cast<float>(normalQuantile((static_cast<double>(i) + 0.5) / static_cast<double>(n)));
+      t[i] = z;
+      t[n - 1 - i] = -z;
+    }
+    return t;
+  }();
+  return table;
+}
+
 CameraNoise::CameraNoise(const CameraConfig& config, std::uint64_t seed)
-    : rgb_sigma_(config.rgb_noise_sigma),
-      depth_k_(config.depth_noise_sigma_per_m2),
+    : depth_k_(config.depth_noise_sigma_per_m2),
       min_depth_m_(config.min_depth_m),
       max_depth_m_(config.max_depth_m),
-      // cv::RNG treats a zero state as a fixed non-zero one; keep every seed distinct from it.
-      rng_(seed ^ 0x9E3779B97F4A7C15ULL) {
+      state_(seed) {
   config.validate();
+  if (config.rgb_noise_sigma > 0.0) {
+    const std::vector<float>& z = normalQuantiles();
+    rgb_levels_.resize(z.size());
+    for (std::size_t i = 0; i < z.size(); ++i) {
+      rgb_levels_[i] = static_cast<std::int16_t>(std::lround(config.rgb_noise_sigma * z[i]));
+    }
+  }
+}
+
+std::uint64_t CameraNoise::next() {
+  std::uint64_t z = (state_ += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
 }
 
 void CameraNoise::apply(RgbdFrame* frame) {
   vo::StageClock clock;
-  if (rgb_sigma_ > 0.0) {
-    noise_.create(frame->bgr.size(), CV_32FC3);
-    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, rgb_sigma_);
-    cv::Mat noisy;
-    frame->bgr.convertTo(noisy, CV_32FC3);
-    noisy += noise_;
-    noisy.convertTo(frame->bgr, CV_8UC3);  // rounds and saturates
+  constexpr std::uint64_t kMask = (std::uint64_t{1} << kQuantileBits) - 1;
+  // The 8-bit value plus a rounded normal sample equals the rounded sum: the value is an integer.
+  if (!rgb_levels_.empty()) {
+    CV_Assert(frame->bgr.type() == CV_8UC3);
+    const std::int16_t* levels = rgb_levels_.data();
+    auto add = [&](std::uint8_t* p, std::uint64_t bits) {
+      *p = static_cast<std::uint8_t>(std::clamp(*p + levels[bits & kMask], 0, 255));
+    };
+    for (int row = 0; row < frame->bgr.rows; ++row) {
+      std::uint8_t* p = frame->bgr.ptr<std::uint8_t>(row);
+      const int n = 3 * frame->bgr.cols;
+      int i = 0;
+      for (; i + 4 <= n; i += 4) {  // four samples per draw
+        const std::uint64_t bits = next();
+        add(p + i, bits);
+        add(p + i + 1, bits >> 16);
+        add(p + i + 2, bits >> 32);
+        add(p + i + 3, bits >> 48);
+      }
+      if (i < n) {
+        for (std::uint64_t bits = next(); i < n; ++i, bits >>= kQuantileBits) add(p + i, bits);
+      }
+    }
   }
   if (depth_k_ > 0.0) {
-    noise_.create(frame->depth_m.size(), CV_32FC1);
-    rng_.fill(noise_, cv::RNG::NORMAL, 0.0, 1.0);
+    const float* z_table = normalQuantiles().data();
     const auto k = static_cast<float>(depth_k_);
     const auto lo = static_cast<float>(min_depth_m_);
     const auto hi = static_cast<float>(max_depth_m_);
     for (int row = 0; row < frame->depth_m.rows; ++row) {
       auto* z = frame->depth_m.ptr<float>(row);
-      const auto* n = noise_.ptr<float>(row);
-      for (int col = 0; col < frame->depth_m.cols; ++col) {
-        if (z[col] <= 0.0f) continue;  // invalid stays invalid
-        const float noisy = z[col] + k * z[col] * z[col] * n[col];
+      std::uint64_t bits = 0;
+      for (int col = 0; col < frame->depth_m.cols; ++col, bits >>= kQuantileBits) {
+        if (col % 4 == 0) bits = next();  // a sample per pixel, used or not: the stream stays aligned
+        if (z[col] <= 0.0f) continue;     // invalid stays invalid
+        const float noisy = z[col] + k * z[col] * z[col] * z_table[bits & kMask];
         z[col] = (noisy >= lo && noisy <= hi) ? noisy : 0.0f;
       }
     }

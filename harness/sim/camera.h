@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "harness/config/camera_config.h"
 #include "harness/sim/egl_context.h"
@@ -41,22 +42,33 @@ struct RgbdFrame {
   Timing cpu;
 };
 
-// The sensor noise of CameraConfig, seeded: Gaussian noise on every colour channel and depth
-// noise of sigma k z^2 on valid depths (a noisy depth outside [min, max] becomes invalid).
-// Frames must be noised in order for a seed to give the same noise.
+// The sensor noise of CameraConfig, seeded: Gaussian noise on every colour channel (rounded to
+// the nearest 8-bit level, saturated) and depth noise of sigma k z^2 on valid depths (a noisy
+// depth outside [min, max] becomes invalid). Frames must be noised in order for a seed to give
+// the same noise.
+//
+// The samples are drawn by inversion: 16 random bits pick one of the 65536 equiprobable
+// quantiles of N(0, 1) (normalQuantiles()), four samples per 64-bit draw of splitmix64. That is a
+// Gaussian to within 1/65536 in probability, its tails cut at 4.32 sigma, at a fraction of the
+// cost of drawing each sample (about 1.2 M samples per 640x480 frame).
 class CameraNoise {
  public:
   CameraNoise(const CameraConfig& config, std::uint64_t seed);
   void apply(RgbdFrame* frame);
 
  private:
-  double rgb_sigma_;
+  std::uint64_t next();  // splitmix64
+
   double depth_k_;
   double min_depth_m_;
   double max_depth_m_;
-  cv::RNG rng_;
-  cv::Mat noise_;  // scratch
+  std::uint64_t state_;
+  std::vector<std::int16_t> rgb_levels_;  // per quantile: sigma z rounded to 8-bit levels; empty: no noise
 };
+
+// The 65536 quantiles of the standard normal distribution at probabilities (i + 0.5) / 65536,
+// in increasing order.
+const std::vector<float>& normalQuantiles();
 
 class Camera {
  public:

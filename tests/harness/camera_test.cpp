@@ -192,6 +192,69 @@ TEST_F(CameraTest, NoiseIsSeededAndBounded) {
       << "std " << stddev[0];
 }
 
+// The table the noise is drawn from: the normal quantiles at (i + 0.5) / 65536, increasing and
+// symmetric, each where the normal CDF puts it (to float precision).
+TEST(CameraNoiseTest, QuantilesAreTheStandardNormals) {
+  const std::vector<float>& z = normalQuantiles();
+  ASSERT_EQ(z.size(), 65536u);
+  double mean = 0.0, var = 0.0;
+  for (std::size_t i = 0; i < z.size(); ++i) {
+    if (i > 0) ASSERT_LT(z[i - 1], z[i]) << i;
+    ASSERT_EQ(z[i], -z[z.size() - 1 - i]);
+    const double p = (static_cast<double>(i) + 0.5) / 65536.0;
+    ASSERT_NEAR(0.5 * std::erfc(-z[i] / std::sqrt(2.0)), p, 1e-7 + 1e-6 * p) << i;
+    mean += z[i];
+    var += static_cast<double>(z[i]) * z[i];
+  }
+  EXPECT_NEAR(mean / 65536.0, 0.0, 1e-9);
+  EXPECT_NEAR(var / 65536.0, 1.0, 1e-3);  // the tails beyond 4.32 sigma are cut
+  EXPECT_NEAR(z.back(), 4.325, 0.001);    // p = 1 - 0.5 / 65536
+  EXPECT_NEAR(z[55137], 1.0, 1e-4);       // Phi(1) = 0.841345 = (55137.4 + 0.5) / 65536
+}
+
+// Colour noise on a mid-grey frame: zero mean, the standard deviation of a rounded Gaussian
+// (sqrt(sigma^2 + 1/12)), the Gaussian's share beyond 1.75 sigma; repeatable per seed, new in
+// every frame. Depth noise keeps invalid pixels invalid.
+TEST(CameraNoiseTest, ColourNoiseIsARoundedGaussian) {
+  CameraConfig config;
+  config.rgb_noise_sigma = 2.0;
+  config.depth_noise_sigma_per_m2 = 0.002;
+  auto grey = [] {
+    RgbdFrame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+    f.depth_m = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.0));
+    f.depth_m(cv::Rect(0, 0, 64, 48)).setTo(0.0f);
+    return f;
+  };
+  CameraNoise noise(config, 7);
+  RgbdFrame a = grey();
+  noise.apply(&a);
+  cv::Mat values;
+  a.bgr.reshape(1).convertTo(values, CV_64F);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(values, mean, stddev);
+  EXPECT_NEAR(mean[0], 128.0, 0.01);
+  EXPECT_NEAR(stddev[0], std::sqrt(4.0 + 1.0 / 12.0), 0.01);
+  const double beyond = cv::countNonZero(cv::abs(values - 128.0) >= 4.0) / static_cast<double>(values.total());
+  EXPECT_NEAR(beyond, std::erfc(1.75 / std::sqrt(2.0)), 0.002);  // |round(2 z)| >= 4 <=> |z| >= 1.75
+  EXPECT_EQ(cv::countNonZero(a.depth_m(cv::Rect(0, 0, 64, 48))), 0);
+  cv::Mat depth_rel = (a.depth_m(cv::Rect(64, 48, 576, 432)) - 2.0) / (0.002 * 4.0);
+  cv::meanStdDev(depth_rel, mean, stddev);
+  EXPECT_NEAR(mean[0], 0.0, 0.01);
+  EXPECT_NEAR(stddev[0], 1.0, 0.01);
+
+  RgbdFrame b = grey();
+  noise.apply(&b);
+  EXPECT_GT(cv::norm(a.bgr, b.bgr, cv::NORM_L1), 0.0);  // a new draw for every frame
+  CameraNoise same(config, 7), other(config, 8);
+  RgbdFrame a2 = grey(), c = grey();
+  same.apply(&a2);
+  other.apply(&c);
+  EXPECT_EQ(cv::norm(a.bgr, a2.bgr, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.depth_m, a2.depth_m, cv::NORM_INF), 0.0);
+  EXPECT_GT(cv::norm(a.bgr, c.bgr, cv::NORM_L1), 0.0);
+}
+
 TEST(CameraConfigTest, ValidateNamesTheOffendingValue) {
   CameraConfig c;
   c.width_px = 3;
