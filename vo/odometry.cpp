@@ -71,9 +71,18 @@ std::array<std::uint64_t, 4> descriptorBits(const cv::Mat& descriptors, int row)
   return bits;
 }
 
+// Bits set, by the parallel bit count: a dozen instructions inline. __builtin_popcountll without
+// -mpopcnt (Debian's x86-64 baseline) calls libgcc's table-driven __popcountdi2 instead.
+inline std::uint64_t popcount64(std::uint64_t x) {
+  x -= (x >> 1) & 0x5555555555555555ULL;
+  x = (x & 0x3333333333333333ULL) + ((x >> 2) & 0x3333333333333333ULL);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0FULL;
+  return (x * 0x0101010101010101ULL) >> 56;
+}
+
 int hamming(const std::array<std::uint64_t, 4>& a, const std::array<std::uint64_t, 4>& b) {
-  return __builtin_popcountll(a[0] ^ b[0]) + __builtin_popcountll(a[1] ^ b[1]) + __builtin_popcountll(a[2] ^ b[2]) +
-         __builtin_popcountll(a[3] ^ b[3]);
+  return static_cast<int>(popcount64(a[0] ^ b[0]) + popcount64(a[1] ^ b[1]) + popcount64(a[2] ^ b[2]) +
+                          popcount64(a[3] ^ b[3]));
 }
 
 cv::Matx33d cameraMatrix(const CameraIntrinsics& c) {
@@ -217,7 +226,8 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
   const Eigen::Isometry3d X_WC = pose.X_CW.inverse();
   velocity_ = X_WC_.inverse() * X_WC;
   X_WC_ = X_WC;
-  result.keyframe = updateLocalMap(frame, matches, pose);
+  result.keyframe_rule = updateLocalMap(frame, matches, pose);
+  result.keyframe = !result.keyframe_rule.empty();
   timeStage(clock, &FrameResult::Timing::map_s, &result);
   if (result.keyframe && config_.ba.enabled) {
     adjustLocalMap(&result);
@@ -304,6 +314,7 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const PreparedFrame& fr
   result.status = TrackingStatus::kOk;
   result.inliers = result.with_depth;
   result.keyframe = true;
+  result.keyframe_rule = "first";
   return result;
 }
 
@@ -435,10 +446,10 @@ int RgbdOdometry::refinePose(const LocalMapMatches& matches, const std::vector<c
   return n;
 }
 
-// After a tracked frame: landmark bookkeeping, a keyframe if needed, culling. Returns whether
-// the frame became a keyframe.
-bool RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches,
-                                  const PoseEstimate& pose) {
+// After a tracked frame: landmark bookkeeping, a keyframe if needed, culling. Returns the rules
+// that made the frame a keyframe (empty: it is not one).
+std::string RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches,
+                                         const PoseEstimate& pose) {
   // Landmark bookkeeping: matched inliers are fresh, expected but unmatched ones age.
   std::vector<bool> seen(landmarks_.size(), false);
   std::vector<int> matched_landmark(frame.features.keypoints.size(), -1);
@@ -456,8 +467,8 @@ bool RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatc
       ++landmarks_[l].misses;
     }
   }
-  const bool keyframe = needsKeyframe(pose.inliers);
-  if (keyframe) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
+  const std::string keyframe = keyframeRules(pose.inliers);
+  if (!keyframe.empty()) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
   // Cull landmarks that keep failing to match where they should be seen (after the keyframe
   // step, which indexes landmarks_ through matched_landmark).
   landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
@@ -467,12 +478,17 @@ bool RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatc
 }
 
 // Keyframe: tracking thins out, or the camera moved or turned enough since the last one.
-bool RgbdOdometry::needsKeyframe(int inliers) const {
+std::string RgbdOdometry::keyframeRules(int inliers) const {
   const Keyframe& last = keyframes_.back();
   const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC_;
-  return inliers < config_.keyframe_inlier_ratio * last.tracked ||
-         rel.translation().norm() > config_.keyframe_translation_m ||
-         rotationAngle(rel.linear()) > config_.keyframe_rotation_rad;
+  std::string rules;
+  auto fire = [&](bool fires, const char* name) {
+    if (fires) rules += (rules.empty() ? "" : "+") + std::string(name);
+  };
+  fire(inliers < config_.keyframe_inlier_ratio * last.tracked, "inliers");
+  fire(rel.translation().norm() > config_.keyframe_translation_m, "translation");
+  fire(rotationAngle(rel.linear()) > config_.keyframe_rotation_rad, "rotation");
+  return rules;
 }
 
 void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame,

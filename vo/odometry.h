@@ -97,6 +97,8 @@ struct FrameResult {
   int matches = 0;                                         // putative matches to the local map
   int inliers = 0;                                         // PnP RANSAC inliers after refinement
   bool keyframe = false;                                   // this frame became a keyframe
+  std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation),
+                              // "inliers", "translation", "rotation"; empty for other frames
   bool reinitialised = false;
   // For a keyframe after bundle adjustment (NaN otherwise): how far BA moved and turned this
   // keyframe's pose, and the observations it rejected as outliers in the window.
@@ -182,14 +184,16 @@ class RgbdOdometry {
   Eigen::Isometry3d predictPose() const { return X_WC_ * velocity_; }  // constant-velocity motion model
   LocalMapMatches matchLocalMap(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred) const;
   PoseEstimate estimatePose(const LocalMapMatches& matches, const Eigen::Isometry3d& X_CW_pred) const;
-  bool updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
+  // Returns the keyframe rules that made the frame a keyframe (empty: not one).
+  std::string updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
   FrameResult lose(FrameResult result, const std::string& why);  // where a step fails
   // Their parts.
   bool backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const;
   int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
                  const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec, Eigen::Isometry3d* X_CW,
                  std::vector<bool>* is_inlier) const;
-  bool needsKeyframe(int inliers) const;
+  // The keyframe rules that fire for the current pose and inliers ('+'-joined; empty: none).
+  std::string keyframeRules(int inliers) const;
   void addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame, const std::vector<int>& matched_landmark,
                    int tracked);
   // Local bundle adjustment after a keyframe; fills result's ba_* fields.

@@ -64,7 +64,7 @@ std::string voCsv(const TrialResult& r) {
   out << std::fixed;
   out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
          "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,ba_correction_m,ba_correction_"
-         "rad,ba_outliers,"
+         "rad,ba_outliers,keyframe_rule,"
          "reason\n";
   for (const TrialFrame& f : r.frames) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
@@ -86,7 +86,7 @@ std::string voCsv(const TrialResult& r) {
     }
     std::string reason = f.vo.reason;
     for (char& c : reason) c = (c == ',' || c == '\n') ? ';' : c;
-    out << ',' << reason << '\n';
+    out << ',' << f.vo.keyframe_rule << ',' << reason << '\n';
   }
   return out.str();
 }

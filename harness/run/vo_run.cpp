@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <system_error>
 
@@ -87,7 +88,9 @@ struct Tracking {
   std::string status_csv;
   int counts[3] = {0, 0, 0};  // ok, weak, lost
   int keyframes = 0;
+  std::map<std::string, int> keyframe_rules;  // how often each rule fired at a keyframe
   int reinitialisations = 0;
+  vo::FrameResult::Timing cpu;  // CPU seconds per stage, summed
   double track_s = 0.0;
   double track_max_s = 0.0;
   double load_s = 0.0;
@@ -105,20 +108,29 @@ void checkFrameSize(const SequenceEntry& e, const SequenceImages& images, const 
 void record(const SequenceEntry& e, const vo::FrameResult& r, Tracking* t) {
   ++t->counts[r.status == vo::TrackingStatus::kOk ? 0 : r.status == vo::TrackingStatus::kWeak ? 1 : 2];
   t->keyframes += r.keyframe ? 1 : 0;
+  for (std::size_t b = 0, e = 0; b < r.keyframe_rule.size(); b = e + 1) {
+    e = std::min(r.keyframe_rule.find('+', b), r.keyframe_rule.size());
+    ++t->keyframe_rules[r.keyframe_rule.substr(b, e - b)];
+  }
+  t->cpu.features_s += r.cpu.features_s;
+  t->cpu.matching_s += r.cpu.matching_s;
+  t->cpu.pnp_s += r.cpu.pnp_s;
+  t->cpu.map_s += r.cpu.map_s;
+  t->cpu.ba_s += r.cpu.ba_s;
   t->reinitialisations += r.reinitialised ? 1 : 0;
   if (r.status != vo::TrackingStatus::kLost) t->est.push_back(vo::StampedPose{e.t_s, r.X_WC});
   char t_text[64];
   std::snprintf(t_text, sizeof(t_text), "%.6f", e.t_s);
   std::ostringstream row;
   row << t_text << ',' << vo::toString(r.status) << ',' << r.features << ',' << r.with_depth << ',' << r.matches << ','
-      << r.inliers << ',' << (r.keyframe ? 1 : 0) << ',' << csvField(r.reason) << '\n';
+      << r.inliers << ',' << (r.keyframe ? 1 : 0) << ',' << r.keyframe_rule << ',' << csvField(r.reason) << '\n';
   t->status_csv += row.str();
 }
 
 Tracking trackSequence(const Sequence& seq, const vo::CameraIntrinsics& camera, vo::RgbdOdometry* odometry,
                        bool progress) {
   Tracking t;
-  t.status_csv = "t,status,features,with_depth,matches,inliers,keyframe,reason\n";
+  t.status_csv = "t,status,features,with_depth,matches,inliers,keyframe,keyframe_rule,reason\n";
   const auto wall0 = Clock::now();
   const std::size_t n = seq.frames.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -184,6 +196,7 @@ nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const 
   j["lost"] = t.counts[2];
   j["failed_at_s"] = numberOrNull(odometry.failedAt());
   j["keyframes"] = t.keyframes;
+  j["keyframe_rules"] = t.keyframe_rules;  // a keyframe may count under several
   j["reinitialise_after_lost"] = config.reinitialise_after_lost;
   j["reinitialisations"] = t.reinitialisations;
   j["unpaired_rgb"] = seq.unpaired_rgb;
@@ -203,6 +216,13 @@ nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const 
   j["ms_per_frame"] = n > 0 ? 1e3 * t.track_s / n : 0.0;
   j["ms_per_frame_max"] = 1e3 * t.track_max_s;
   j["load_ms_per_frame"] = n > 0 ? 1e3 * t.load_s / n : 0.0;
+  const double per_frame = n > 0 ? 1e3 / static_cast<double>(n) : 0.0;
+  j["cpu_ms_per_frame"] = {{"features", t.cpu.features_s * per_frame},
+                           {"matching", t.cpu.matching_s * per_frame},
+                           {"pnp", t.cpu.pnp_s * per_frame},
+                           {"map", t.cpu.map_s * per_frame},
+                           {"ba", t.cpu.ba_s * per_frame},
+                           {"total", t.cpu.total() * per_frame}};
   j["wall_time_s"] = t.wall_s;
   return j;
 }

@@ -387,7 +387,7 @@ TEST(CliRecord, RecordsATumSequenceThatVoRuns) {
   std::ifstream status(out / "status.csv");
   std::string header;
   std::getline(status, header);
-  EXPECT_EQ(header, "t,status,features,with_depth,matches,inliers,keyframe,reason");
+  EXPECT_EQ(header, "t,status,features,with_depth,matches,inliers,keyframe,keyframe_rule,reason");
   const nlohmann::json summary = readJson(out / "summary.json");
   EXPECT_EQ(summary["frames"].get<int>(), frames);
   EXPECT_EQ(summary["ok"].get<int>() + summary["weak"].get<int>() + summary["lost"].get<int>(), frames);
