@@ -13,19 +13,20 @@
 #include <utility>
 
 #include "vo/check.h"
+#include "vo/odometry_detail.h"
 #include "vo/stage_clock.h"
 
 namespace tgnav::vo {
 
 namespace {
 
-double rotationAngle(const Eigen::Matrix3d& R) { return Eigen::AngleAxisd(R).angle(); }
+using detail::descriptorBits;
 
-// The time since the clock's previous lap, as a stage of `result` (wall and CPU seconds).
+// The time since the clock's previous lap, added to a stage of `result` (wall and CPU seconds).
 void timeStage(StageClock& clock, double FrameResult::Timing::*stage, FrameResult* result) {
   const StageClock::Lap lap = clock.lap();
-  result->timing.*stage = lap.wall_s;
-  result->cpu.*stage = lap.cpu_s;
+  result->timing.*stage += lap.wall_s;
+  result->cpu.*stage += lap.cpu_s;
 }
 
 // Keypoints bucketed on a coarse grid, for window searches around a predicted pixel.
@@ -64,12 +65,6 @@ class KeypointGrid {
   int rows_;
   std::vector<std::vector<int>> cells_;
 };
-
-std::array<std::uint64_t, 4> descriptorBits(const cv::Mat& descriptors, int row) {
-  std::array<std::uint64_t, 4> bits{};
-  std::memcpy(bits.data(), descriptors.ptr<std::uint8_t>(row), sizeof(bits));
-  return bits;
-}
 
 // Bits set, by the parallel bit count: a dozen instructions inline. __builtin_popcountll without
 // -mpopcnt (Debian's x86-64 baseline) calls libgcc's table-driven __popcountdi2 instead.
@@ -121,6 +116,11 @@ void OdometryConfig::validate() const {
   require(keyframe_translation_m > 0.0, "keyframe_translation_m", keyframe_translation_m, "must be > 0");
   require(keyframe_rotation_rad > 0.0, "keyframe_rotation_rad", keyframe_rotation_rad, "must be > 0");
   require(landmark_max_misses >= 1, "landmark_max_misses", landmark_max_misses, "must be >= 1");
+  require(keyframe_reference_ratio > 0.0 && keyframe_reference_ratio <= 1.0, "keyframe_reference_ratio",
+          keyframe_reference_ratio, "must be in (0, 1]");
+  require(keyframe_max_frames >= 1, "keyframe_max_frames", keyframe_max_frames, "must be >= 1");
+  require(std::isfinite(keyframe_close_depth_m) && keyframe_close_depth_m > 0.0, "keyframe_close_depth_m",
+          keyframe_close_depth_m, "must be > 0");
   ba.validate();
 }
 
@@ -156,23 +156,6 @@ RgbdOdometry::RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig&
   require(std::isfinite(camera.cx) && std::isfinite(camera.cy), "camera.cx", camera.cx, "must be finite");
 }
 
-// The local map's landmarks matched to a frame's keypoints, and the 2D-3D correspondences.
-struct RgbdOdometry::LocalMapMatches {
-  std::vector<int> landmark_of;     // keypoint -> landmark (-1: none)
-  std::vector<bool> expected;       // landmark -> projects into the image from the prediction
-  std::vector<cv::Point3d> object;  // landmark positions, in keypoint order
-  std::vector<cv::Point2d> pixels;  // their keypoints' pixels
-  std::vector<int> keypoint;        // correspondence -> keypoint
-};
-
-struct RgbdOdometry::PoseEstimate {
-  bool ransac_ok = false;  // PnP RANSAC found a pose with at least min_inliers inliers
-  int ransac_inliers = 0;
-  int inliers = -1;  // of the refined pose among all correspondences (-1: non-finite pose)
-  Eigen::Isometry3d X_CW = Eigen::Isometry3d::Identity();
-  std::vector<bool> is_inlier;  // per correspondence
-};
-
 FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
   const double t_s = frame.t_s;
   if (!std::isfinite(t_s) || t_s <= last_t_) {
@@ -203,6 +186,8 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
     return record(first);
   }
 
+  applyDueAdjustment(&result);  // the bundle adjustment due now, if one is
+  timeStage(clock, &FrameResult::Timing::ba_s, &result);
   const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
   const LocalMapMatches matches = matchLocalMap(frame, X_CW_pred);
   timeStage(clock, &FrameResult::Timing::matching_s, &result);
@@ -230,7 +215,7 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
   result.keyframe = !result.keyframe_rule.empty();
   timeStage(clock, &FrameResult::Timing::map_s, &result);
   if (result.keyframe && config_.ba.enabled) {
-    adjustLocalMap(&result);
+    adjustAfterKeyframe(&result);
     timeStage(clock, &FrameResult::Timing::ba_s, &result);
   }
   result.X_WC = X_WC_;
@@ -306,9 +291,11 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const PreparedFrame& fr
   result.reinitialised = !history_.empty();
   X_WC_ = X_WC0_;
   velocity_.setIdentity();
+  dropBundleAdjustment();
   landmarks_.clear();
   keyframes_.clear();
   retired_.clear();
+  keyframes_since_init_ = 0;
   addKeyframe(X_WC_, frame, std::vector<int>(frame.features.keypoints.size(), -1), 0);
   result.X_WC = X_WC_;
   result.status = TrackingStatus::kOk;
@@ -446,183 +433,6 @@ int RgbdOdometry::refinePose(const LocalMapMatches& matches, const std::vector<c
   return n;
 }
 
-// After a tracked frame: landmark bookkeeping, a keyframe if needed, culling. Returns the rules
-// that made the frame a keyframe (empty: it is not one).
-std::string RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches,
-                                         const PoseEstimate& pose) {
-  // Landmark bookkeeping: matched inliers are fresh, expected but unmatched ones age.
-  std::vector<bool> seen(landmarks_.size(), false);
-  std::vector<int> matched_landmark(frame.features.keypoints.size(), -1);
-  for (std::size_t m = 0; m < matches.object.size(); ++m) {
-    if (!pose.is_inlier[m]) continue;
-    const int k = matches.keypoint[m];
-    const int l = matches.landmark_of[static_cast<std::size_t>(k)];
-    seen[static_cast<std::size_t>(l)] = true;
-    matched_landmark[static_cast<std::size_t>(k)] = l;
-  }
-  for (std::size_t l = 0; l < landmarks_.size(); ++l) {
-    if (seen[l]) {
-      landmarks_[l].misses = 0;
-    } else if (matches.expected[l]) {
-      ++landmarks_[l].misses;
-    }
-  }
-  const std::string keyframe = keyframeRules(pose.inliers);
-  if (!keyframe.empty()) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
-  // Cull landmarks that keep failing to match where they should be seen (after the keyframe
-  // step, which indexes landmarks_ through matched_landmark).
-  landmarks_.erase(std::remove_if(landmarks_.begin(), landmarks_.end(),
-                                  [&](const Landmark& lm) { return lm.misses > config_.landmark_max_misses; }),
-                   landmarks_.end());
-  return keyframe;
-}
-
-// Keyframe: tracking thins out, or the camera moved or turned enough since the last one.
-std::string RgbdOdometry::keyframeRules(int inliers) const {
-  const Keyframe& last = keyframes_.back();
-  const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC_;
-  std::string rules;
-  auto fire = [&](bool fires, const char* name) {
-    if (fires) rules += (rules.empty() ? "" : "+") + std::string(name);
-  };
-  fire(inliers < config_.keyframe_inlier_ratio * last.tracked, "inliers");
-  fire(rel.translation().norm() > config_.keyframe_translation_m, "translation");
-  fire(rotationAngle(rel.linear()) > config_.keyframe_rotation_rad, "rotation");
-  return rules;
-}
-
-void RgbdOdometry::addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame,
-                               const std::vector<int>& matched_landmark, int tracked) {
-  Keyframe kf;
-  kf.id = next_keyframe_id_++;
-  kf.X_WC = X_WC;
-  int created = 0;
-  const double sigma_step = config_.features.scale_factor;
-  for (std::size_t i = 0; i < frame.features.keypoints.size(); ++i) {
-    const cv::KeyPoint& kp = frame.features.keypoints[i];
-    Observation obs;
-    obs.uv = Eigen::Vector2d(kp.pt.x, kp.pt.y);
-    obs.depth_m = frame.valid[i] ? frame.p_C[i].z() : 0.0;
-    obs.sigma_px = std::pow(sigma_step, std::max(0, kp.octave));
-    if (matched_landmark[i] >= 0) {  // tracked: the landmark exists, and now belongs here
-      Landmark& lm = landmarks_[static_cast<std::size_t>(matched_landmark[i])];
-      obs.landmark = lm.id;
-      lm.keyframe = kf.id;
-      kf.observations.push_back(obs);
-      continue;
-    }
-    if (!frame.valid[i]) continue;
-    Landmark lm;
-    lm.id = next_landmark_id_++;
-    obs.landmark = lm.id;
-    kf.observations.push_back(obs);
-    lm.p_W = X_WC * frame.p_C[i];
-    lm.descriptor = descriptorBits(frame.features.descriptors, static_cast<int>(i));
-    lm.keyframe = kf.id;
-    landmarks_.push_back(std::move(lm));
-    ++created;
-  }
-  kf.tracked = tracked + created;
-  keyframes_.push_back(kf);
-  // The local map: landmarks observed by the last local_map_keyframes keyframes (a landmark
-  // belongs to the newest keyframe that observed it, and leaves the map with that keyframe).
-  while (static_cast<int>(keyframes_.size()) > config_.local_map_keyframes) {
-    const int gone = keyframes_.front().id;
-    // It stays, fixed, in bundle adjustment's window for a while: its observations of the
-    // landmarks that outlive it anchor them.
-    retired_.push_back(std::move(keyframes_.front()));
-    while (static_cast<int>(retired_.size()) > config_.ba.fixed_keyframes) retired_.pop_front();
-    keyframes_.pop_front();
-    landmarks_.erase(
-        std::remove_if(landmarks_.begin(), landmarks_.end(), [&](const Landmark& lm) { return lm.keyframe == gone; }),
-        landmarks_.end());
-  }
-}
-
-// Local bundle adjustment: the local map's keyframes are free, the last ba.fixed_keyframes that
-// left it are fixed (the gauge; until there are any, the oldest local keyframe is fixed), and
-// every landmark they observe is free. The new keyframe's pose becomes the current estimate.
-void RgbdOdometry::adjustLocalMap(FrameResult* result) {
-  if (retired_.empty() && keyframes_.size() < 2) return;
-  std::vector<Keyframe*> window;
-  for (Keyframe& kf : retired_) window.push_back(&kf);
-  for (Keyframe& kf : keyframes_) window.push_back(&kf);
-  const std::size_t fixed = retired_.empty() ? 1 : retired_.size();
-  std::unordered_map<long, int> index_of;  // landmark id -> index in landmarks_
-  index_of.reserve(landmarks_.size());
-  for (std::size_t l = 0; l < landmarks_.size(); ++l) index_of.emplace(landmarks_[l].id, static_cast<int>(l));
-
-  BaProblem problem;
-  std::vector<int> landmark_of;                        // problem landmark -> landmarks_ index
-  std::vector<int> in_problem(landmarks_.size(), -1);  // landmarks_ index -> problem landmark
-  std::vector<std::pair<int, int>> source;             // problem observation -> (window keyframe, observation)
-  for (std::size_t k = 0; k < window.size(); ++k) {
-    problem.X_CW.push_back(window[k]->X_WC.inverse());
-    problem.fixed.push_back(k < fixed);
-    const std::vector<Observation>& obs = window[k]->observations;
-    for (std::size_t o = 0; o < obs.size(); ++o) {
-      const auto found = index_of.find(obs[o].landmark);
-      if (found == index_of.end()) continue;  // culled, or gone with its keyframe
-      int& j = in_problem[static_cast<std::size_t>(found->second)];
-      if (j < 0) {
-        j = static_cast<int>(problem.p_W.size());
-        problem.p_W.push_back(landmarks_[static_cast<std::size_t>(found->second)].p_W);
-        landmark_of.push_back(found->second);
-      }
-      BaObservation b;
-      b.keyframe = static_cast<int>(k);
-      b.landmark = j;
-      b.uv = obs[o].uv;
-      b.depth_m = obs[o].depth_m;
-      b.sigma_px = obs[o].sigma_px;
-      problem.observations.push_back(b);
-      source.emplace_back(static_cast<int>(k), static_cast<int>(o));
-    }
-  }
-  const BaReport report = bundleAdjust(&problem, camera_, config_.ba);
-  if (!report.solved) return;
-
-  const Eigen::Isometry3d before = keyframes_.back().X_WC;
-  for (std::size_t k = fixed; k < window.size(); ++k) window[k]->X_WC = problem.X_CW[k].inverse();
-  for (std::size_t j = 0; j < landmark_of.size(); ++j) {
-    landmarks_[static_cast<std::size_t>(landmark_of[j])].p_W = problem.p_W[j];
-  }
-  // Outlier observations go; a landmark with no observation left in the window goes too.
-  std::vector<int> inliers_of(problem.p_W.size(), 0);
-  std::vector<std::vector<bool>> drop(window.size());
-  for (std::size_t k = 0; k < window.size(); ++k) drop[k].assign(window[k]->observations.size(), false);
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    if (report.outlier[i]) {
-      drop[static_cast<std::size_t>(source[i].first)][static_cast<std::size_t>(source[i].second)] = true;
-    } else {
-      ++inliers_of[static_cast<std::size_t>(problem.observations[i].landmark)];
-    }
-  }
-  for (std::size_t k = 0; k < window.size(); ++k) {
-    std::vector<Observation>& obs = window[k]->observations;
-    std::size_t w = 0;
-    for (std::size_t o = 0; o < obs.size(); ++o) {
-      if (!drop[k][o]) obs[w++] = obs[o];
-    }
-    obs.resize(w);
-  }
-  std::vector<bool> remove(landmarks_.size(), false);
-  for (std::size_t j = 0; j < landmark_of.size(); ++j) {
-    if (inliers_of[j] == 0) remove[static_cast<std::size_t>(landmark_of[j])] = true;
-  }
-  std::size_t w = 0;
-  for (std::size_t l = 0; l < landmarks_.size(); ++l) {
-    if (!remove[l]) landmarks_[w++] = std::move(landmarks_[l]);
-  }
-  landmarks_.resize(w);
-
-  X_WC_ = keyframes_.back().X_WC;
-  const Eigen::Isometry3d change = before.inverse() * X_WC_;
-  result->ba_correction_m = change.translation().norm();
-  result->ba_correction_rad = rotationAngle(change.linear());
-  result->ba_outliers = report.outliers;
-}
-
 // Lost: the last good pose stands; with reinitialise_after_lost the next frame with enough
 // features starts again from it.
 FrameResult RgbdOdometry::lose(FrameResult result, const std::string& why) {
@@ -633,6 +443,7 @@ FrameResult RgbdOdometry::lose(FrameResult result, const std::string& why) {
   if (config_.reinitialise_after_lost) {
     initialised_ = false;
     X_WC0_ = X_WC_;  // carry on from the last good pose
+    dropBundleAdjustment();
     landmarks_.clear();
     keyframes_.clear();
     retired_.clear();

@@ -2,11 +2,35 @@
 // RGB-D feature visual odometry: ORB features (grid-spread) with depth, tracked against a local
 // map of the recent keyframes' 3D landmarks by descriptor matching inside a motion-model window,
 // pose by PnP RANSAC refined on the inliers (Levenberg-Marquardt on reprojection error),
-// keyframes by inlier ratio and motion, landmarks culled when they stop being matched. When a
-// keyframe is added, a local bundle adjustment (vo/bundle_adjustment.h) refines the local map's
-// keyframes and the landmarks they observe, with the last keyframes that left the local map held
-// fixed as the gauge (their observations anchor the landmarks that outlived them); outlier
-// observations are dropped, and a landmark left without any is removed.
+// keyframes by one of two policies (keyframe_policy), landmarks culled when they stop being
+// matched. When a keyframe is added, a local bundle adjustment (vo/bundle_adjustment.h) refines
+// the local map's keyframes and the landmarks they observe, with the last keyframes that left the
+// local map held fixed as the gauge (their observations anchor the landmarks that outlived them);
+// outlier observations are dropped, and a landmark left without any is removed.
+//
+// Keyframe policies. `ratio`: a keyframe when the inliers fall below keyframe_inlier_ratio of
+// those the last keyframe tracked and created, or the camera moved or turned far enough since
+// it. `orbslam2`: ORB-SLAM2's decision for an RGB-D camera (Tracking::NeedNewKeyFrame): the
+// frame tracks fewer than keyframe_reference_ratio (0.75; 0.4 while there is one keyframe) of the
+// reference keyframe's well-observed landmarks (observed twice or more: ORB-SLAM2 counts an
+// observation with depth twice and wants 3 counts, 2 while there are at most two keyframes), or
+// it tracks fewer than 100 close landmarks (depth below keyframe_close_depth_m) while 70 close
+// features are unmatched; and it tracks more than 15; and either keyframe_max_frames frames
+// passed since the last keyframe, or bundle adjustment is idle, or tracking is weak (fewer than a
+// quarter of the reference count, or the close condition). The reference keyframe is the last
+// one (ORB-SLAM2 takes the one sharing most landmarks with the frame); ORB-SLAM2 also culls
+// redundant keyframes later, which this VO does not (its local map is the last
+// local_map_keyframes keyframes, so the window's length in time grows as keyframes thin out).
+//
+// Bundle adjustment in the background (ba.latency_frames = L > 0): the adjustment of a keyframe
+// added at frame k is solved on a thread of its own, on a copy of the window as it was at k, and
+// applied at frame k + L, before that frame is tracked, whether it finished early or the frame
+// waits for it; so the result is the same however fast the thread runs, and the same in every
+// run. While one is in flight a new keyframe's adjustment waits: it starts when the one in
+// flight is applied (ORB-SLAM2's local mapping takes keyframes from a queue the same way). Where
+// the window moved, the frames tracked meanwhile move with it: the current pose, and the
+// keyframes and landmarks added after the copy, take the correction of the newest adjusted
+// keyframe. L = 0 adjusts at the keyframe itself, before the next frame.
 //
 // Tracking status per frame, with the counts behind it: ok, weak (few inliers), lost (inliers
 // below min_inliers, ORB-SLAM2's 30 by default). The paper counts a run as failed at the first
@@ -17,8 +41,10 @@
 #include <cstdint>
 #include <deque>
 #include <limits>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "vo/bundle_adjustment.h"
@@ -26,6 +52,11 @@
 #include "vo/features.h"
 
 namespace tgnav::vo {
+
+enum class KeyframePolicy { kRatio, kOrbSlam2 };
+inline std::vector<std::pair<std::string, KeyframePolicy>> keyframePolicyNames() {
+  return {{"ratio", KeyframePolicy::kRatio}, {"orbslam2", KeyframePolicy::kOrbSlam2}};
+}
 
 struct OdometryConfig {
   FeatureConfig features;
@@ -49,6 +80,12 @@ struct OdometryConfig {
   double keyframe_translation_m = 0.4;  // ... or the camera moved this far
   double keyframe_rotation_rad = 0.35;  // ... or turned this much
   int landmark_max_misses = 10;         // cull a landmark not matched in this many frames it was expected in
+  KeyframePolicy keyframe_policy = KeyframePolicy::kRatio;
+  double keyframe_reference_ratio = 0.75;  // orbslam2: ORB-SLAM2's thRefRatio for RGB-D
+  int keyframe_max_frames = 20;            // orbslam2: frames after which a keyframe may come even
+                                           // while BA is busy (ORB-SLAM2: the camera's rate)
+  double keyframe_close_depth_m = 3.2;     // orbslam2: "close" landmarks (ORB-SLAM2: 40 baselines,
+                                           // here of ba.virtual_baseline_m)
   bool reinitialise_after_lost = false;
   BundleAdjustmentConfig ba;  // local bundle adjustment over the local map's keyframes
 
@@ -74,6 +111,10 @@ struct OdometryConfig {
     a("keyframe_translation_m", keyframe_translation_m);
     a("keyframe_rotation_rad", keyframe_rotation_rad);
     a("landmark_max_misses", landmark_max_misses);
+    a.choice("keyframe_policy", keyframe_policy, keyframePolicyNames());
+    a("keyframe_reference_ratio", keyframe_reference_ratio);
+    a("keyframe_max_frames", keyframe_max_frames);
+    a("keyframe_close_depth_m", keyframe_close_depth_m);
     a("reinitialise_after_lost", reinitialise_after_lost);
     a("ba", ba);
   }
@@ -97,11 +138,13 @@ struct FrameResult {
   int matches = 0;                                         // putative matches to the local map
   int inliers = 0;                                         // PnP RANSAC inliers after refinement
   bool keyframe = false;                                   // this frame became a keyframe
-  std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation),
-                              // "inliers", "translation", "rotation"; empty for other frames
+  std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation);
+                              // ratio: "inliers", "translation", "rotation"; orbslam2: "reference",
+                              // "close"; empty for other frames
   bool reinitialised = false;
-  // For a keyframe after bundle adjustment (NaN otherwise): how far BA moved and turned this
-  // keyframe's pose, and the observations it rejected as outliers in the window.
+  // For a frame where a bundle adjustment was applied (NaN otherwise; the keyframe itself with
+  // ba.latency_frames 0, latency_frames later otherwise): how far BA moved and turned the
+  // newest keyframe of its window, and the observations it rejected as outliers in the window.
   double ba_correction_m = std::numeric_limits<double>::quiet_NaN();
   double ba_correction_rad = std::numeric_limits<double>::quiet_NaN();
   int ba_outliers = 0;
@@ -109,7 +152,9 @@ struct FrameResult {
   // Seconds of track()'s stages (not deterministic; never written to results that must repeat):
   // ORB and back-projection, local-map matching, PnP (RANSAC and refinement), local-map upkeep
   // (keyframe, landmarks), bundle adjustment; on the wall clock (`timing`) and on the CPU clock of
-  // the thread that ran the stage (`cpu`).
+  // the thread that ran the stage (`cpu`). Bundle adjustment in the background: `timing.ba_s` is
+  // what the tracking waited for it and spent applying it; `cpu.ba_s` also holds the solve's CPU,
+  // on its own thread, counted at the frame that applies it.
   struct Timing {
     double features_s = 0.0;
     double matching_s = 0.0;
@@ -127,6 +172,9 @@ class RgbdOdometry {
   // `X_WC0`: the pose the first frame is given (e.g. ground truth's, or identity).
   RgbdOdometry(const CameraIntrinsics& camera, const OdometryConfig& config,
                const Eigen::Isometry3d& X_WC0 = Eigen::Isometry3d::Identity());
+  ~RgbdOdometry();  // waits for a bundle adjustment in flight
+  RgbdOdometry(const RgbdOdometry&) = delete;
+  RgbdOdometry& operator=(const RgbdOdometry&) = delete;
 
   // A frame's keypoints with their descriptors and 3D points: all track() needs of the images.
   // Preparing does not depend on the odometry's state, so one thread may prepare the next frames
@@ -160,7 +208,8 @@ class RgbdOdometry {
     Eigen::Vector3d p_W;
     std::array<std::uint64_t, 4> descriptor{};  // the 256-bit ORB descriptor
     int misses = 0;
-    int keyframe = 0;  // id of the newest keyframe that observed it (created or tracked it)
+    int keyframe = 0;      // id of the newest keyframe that observed it (created or tracked it)
+    int observations = 0;  // ORB-SLAM2's count: 2 per keyframe that observed it with depth, else 1
   };
   struct Observation {
     long landmark = 0;  // Landmark::id
@@ -176,6 +225,7 @@ class RgbdOdometry {
   };
   struct LocalMapMatches;  // landmarks matched to a frame's keypoints
   struct PoseEstimate;     // PnP RANSAC and its refinement
+  struct BaJob;            // a bundle adjustment: its window, and its solution or the thread solving it
 
   // The steps of track, in order (initialise instead of the rest for a first frame, or the
   // first after a loss with reinitialise_after_lost).
@@ -192,12 +242,19 @@ class RgbdOdometry {
   int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
                  const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec, Eigen::Isometry3d* X_CW,
                  std::vector<bool>* is_inlier) const;
-  // The keyframe rules that fire for the current pose and inliers ('+'-joined; empty: none).
-  std::string keyframeRules(int inliers) const;
+  // The keyframe rules that fire ('+'-joined; empty: none): ratioRules for the current pose and
+  // inliers, orbSlam2Rules also from the frame's close features, tracked or not.
+  std::string ratioRules(int inliers) const;
+  std::string orbSlam2Rules(int inliers, const PreparedFrame& frame, const std::vector<int>& matched_landmark) const;
   void addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame, const std::vector<int>& matched_landmark,
                    int tracked);
-  // Local bundle adjustment after a keyframe; fills result's ba_* fields.
-  void adjustLocalMap(FrameResult* result);
+  // Local bundle adjustment: the window copied and solved (inline, or started on its own thread),
+  // then applied to the map (at once, or at the frame it is due).
+  std::unique_ptr<BaJob> startBundleAdjustment();
+  void applyBundleAdjustment(BaJob& job, FrameResult* result);
+  void adjustAfterKeyframe(FrameResult* result);  // at a keyframe: start one, or queue it
+  void applyDueAdjustment(FrameResult* result);   // before tracking a frame: apply the one due
+  void dropBundleAdjustment();                    // on a reset: the one in flight is discarded
   void markFailed(double t_s);                    // the first loss
   FrameResult record(const FrameResult& result);  // into history_
 
@@ -217,6 +274,10 @@ class RgbdOdometry {
   int next_keyframe_id_ = 0;
   long next_landmark_id_ = 0;
   long frame_ = 0;  // frames tracked
+  int keyframes_since_init_ = 0;
+  long last_keyframe_frame_ = 0;
+  std::unique_ptr<BaJob> ba_job_;  // the bundle adjustment in flight (ba.latency_frames > 0)
+  bool ba_queued_ = false;         // a keyframe came while it was: adjust again once it is applied
   std::vector<FrameResult> history_;
 };
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 
 namespace tgnav::vo {
 namespace {
@@ -73,11 +74,26 @@ double poseError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.inverse().translation() - b.inverse().translation()).norm();
 }
 
-TEST(BundleAdjustment, RecoversPerturbedPosesAndLandmarksWithDepth) {
+// Each test of the optimiser runs with both solvers: the Schur-complement one written for this
+// problem (the default) and Ceres (the reference).
+class BundleAdjustmentSolvers : public ::testing::TestWithParam<BaSolver> {
+ protected:
+  BundleAdjustmentConfig config() const {
+    BundleAdjustmentConfig c;
+    c.solver = GetParam();
+    return c;
+  }
+};
+INSTANTIATE_TEST_SUITE_P(Solvers, BundleAdjustmentSolvers, ::testing::Values(BaSolver::kSchur, BaSolver::kCeres),
+                         [](const ::testing::TestParamInfo<BaSolver>& info) {
+                           return info.param == BaSolver::kSchur ? std::string("schur") : std::string("ceres");
+                         });
+
+TEST_P(BundleAdjustmentSolvers, RecoversPerturbedPosesAndLandmarksWithDepth) {
   Window w = makeWindow(5, 300, /*depth=*/true, 1);
   perturb(&w.problem, 0.05, 0.02, 0.05, 2);
   const Eigen::Isometry3d fixed_before = w.problem.X_CW[0];
-  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config());
   ASSERT_TRUE(report.solved);
   EXPECT_EQ(report.outliers, 0);
   EXPECT_LT(report.final_cost, 1e-6 * report.initial_cost);
@@ -95,11 +111,11 @@ TEST(BundleAdjustment, RecoversPerturbedPosesAndLandmarksWithDepth) {
 }
 
 // Without depth, two fixed keyframes set the scale (monocular BA's gauge).
-TEST(BundleAdjustment, ReprojectionAloneConvergesWithTwoFixedKeyframes) {
+TEST_P(BundleAdjustmentSolvers, ReprojectionAloneConvergesWithTwoFixedKeyframes) {
   Window w = makeWindow(5, 300, /*depth=*/false, 3);
   w.problem.fixed[1] = true;
   perturb(&w.problem, 0.02, 0.01, 0.02, 4);
-  BundleAdjustmentConfig config;
+  BundleAdjustmentConfig config = this->config();
   config.max_iterations = 50;
   const BaReport report = bundleAdjust(&w.problem, kCamera, config);
   ASSERT_TRUE(report.solved);
@@ -109,7 +125,7 @@ TEST(BundleAdjustment, ReprojectionAloneConvergesWithTwoFixedKeyframes) {
 }
 
 // Observations moved 40 px off (mismatches) are flagged and do not pull the poses.
-TEST(BundleAdjustment, FlagsGrossOutliersAndIgnoresThem) {
+TEST_P(BundleAdjustmentSolvers, FlagsGrossOutliersAndIgnoresThem) {
   Window w = makeWindow(5, 300, /*depth=*/true, 5);
   std::vector<bool> corrupted(w.problem.observations.size(), false);
   for (std::size_t i = 7; i < w.problem.observations.size(); i += 25) {
@@ -117,7 +133,7 @@ TEST(BundleAdjustment, FlagsGrossOutliersAndIgnoresThem) {
     corrupted[i] = true;
   }
   perturb(&w.problem, 0.03, 0.01, 0.0, 6);
-  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config());
   ASSERT_TRUE(report.solved);
   int caught = 0, false_alarms = 0;
   for (std::size_t i = 0; i < corrupted.size(); ++i) {
@@ -136,7 +152,7 @@ TEST(BundleAdjustment, FlagsGrossOutliersAndIgnoresThem) {
 
 // A keypoint on a coarse pyramid level (large sigma) weighs less: the same pixel error is not an
 // outlier there.
-TEST(BundleAdjustment, CoarseKeypointsAreWeightedByTheirScale) {
+TEST_P(BundleAdjustmentSolvers, CoarseKeypointsAreWeightedByTheirScale) {
   Window w = makeWindow(3, 200, /*depth=*/true, 7);
   for (BaObservation& o : w.problem.observations) {
     if (o.keyframe == 2 && o.landmark % 2 == 0) {
@@ -144,15 +160,15 @@ TEST(BundleAdjustment, CoarseKeypointsAreWeightedByTheirScale) {
       o.sigma_px = 1.2 * 1.2 * 1.2 * 1.2 * 1.2 * 1.2;  // octave 6
     }
   }
-  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config());
   ASSERT_TRUE(report.solved);
   EXPECT_EQ(report.outliers, 0);
 }
 
-TEST(BundleAdjustment, NothingToDoWithoutAFreeKeyframe) {
+TEST_P(BundleAdjustmentSolvers, NothingToDoWithoutAFreeKeyframe) {
   Window w = makeWindow(3, 50, true, 8);
   w.problem.fixed.assign(3, true);
-  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config());
   EXPECT_FALSE(report.solved);
   EXPECT_EQ(report.outliers, 0);
 }
@@ -177,7 +193,7 @@ TEST(BundleAdjustment, RefusesBadIndicesAndConfigs) {
 
 // A landmark observed once is placed on its observation from the adjusted pose (at the observed
 // depth, or without depth at the depth it had), and does not move the poses.
-TEST(BundleAdjustment, LandmarksObservedOnceArePlacedOnTheirObservation) {
+TEST_P(BundleAdjustmentSolvers, LandmarksObservedOnceArePlacedOnTheirObservation) {
   Window w = makeWindow(5, 200, true, 21);
   perturb(&w.problem, 0.03, 0.01, 0.03, 22);
   Window without = w;
@@ -194,8 +210,8 @@ TEST(BundleAdjustment, LandmarksObservedOnceArePlacedOnTheirObservation) {
     w.problem.p_W.push_back(w.problem.X_CW[k].inverse() * Eigen::Vector3d(depth ? -1.3 : 1.2, 0.5, 3.5));
   }
   const Eigen::Vector3d before_mono = w.problem.X_CW[k] * w.problem.p_W.back();
-  const BaReport report = bundleAdjust(&w.problem, kCamera, BundleAdjustmentConfig{});
-  bundleAdjust(&without.problem, kCamera, BundleAdjustmentConfig{});
+  const BaReport report = bundleAdjust(&w.problem, kCamera, config());
+  bundleAdjust(&without.problem, kCamera, config());
   ASSERT_TRUE(report.solved);
   EXPECT_EQ(report.outliers, 0);
   for (std::size_t j = 0; j < w.problem.X_CW.size(); ++j) {
@@ -271,16 +287,49 @@ TEST(BundleAdjustment, AnalyticJacobiansMatchFiniteDifferences) {
 }
 
 // The same problem gives the same result, bit for bit (one thread, fixed ordering).
-TEST(BundleAdjustment, Deterministic) {
+TEST_P(BundleAdjustmentSolvers, Deterministic) {
   Window a = makeWindow(5, 200, true, 10);
   perturb(&a.problem, 0.05, 0.02, 0.05, 11);
   Window b = a;
-  bundleAdjust(&a.problem, kCamera, BundleAdjustmentConfig{});
-  bundleAdjust(&b.problem, kCamera, BundleAdjustmentConfig{});
+  bundleAdjust(&a.problem, kCamera, config());
+  bundleAdjust(&b.problem, kCamera, config());
   for (std::size_t k = 0; k < a.problem.X_CW.size(); ++k) {
     EXPECT_TRUE(a.problem.X_CW[k].matrix() == b.problem.X_CW[k].matrix());
   }
   for (std::size_t l = 0; l < a.problem.p_W.size(); ++l) EXPECT_TRUE(a.problem.p_W[l] == b.problem.p_W[l]);
+}
+
+// The Schur solver takes Ceres's steps: on windows with and without depth, one or two fixed
+// keyframes, planted mismatches and perturbed starts, both end at the same poses and landmarks
+// (to rounding), with the same outliers, iterations and costs.
+TEST(BundleAdjustment, SchurSolverAgreesWithCeres) {
+  for (unsigned seed = 30; seed < 36; ++seed) {
+    const bool depth = seed % 3 != 0;
+    Window w = makeWindow(6, 250, depth, seed);
+    if (!depth) w.problem.fixed[1] = true;
+    for (std::size_t i = seed % 7; i < w.problem.observations.size(); i += 31) {
+      w.problem.observations[i].uv += Eigen::Vector2d(25.0, 30.0);
+    }
+    for (std::size_t i = 0; i < w.problem.observations.size(); i += 5) w.problem.observations[i].depth_m = 0.0;
+    perturb(&w.problem, 0.04, 0.015, 0.04, seed + 100);
+    BaProblem schur = w.problem, ceres = w.problem;
+    BundleAdjustmentConfig config;
+    config.solver = BaSolver::kSchur;
+    const BaReport a = bundleAdjust(&schur, kCamera, config);
+    config.solver = BaSolver::kCeres;
+    const BaReport b = bundleAdjust(&ceres, kCamera, config);
+    ASSERT_TRUE(a.solved && b.solved) << "seed " << seed;
+    EXPECT_EQ(a.outlier, b.outlier) << "seed " << seed;
+    EXPECT_EQ(a.iterations, b.iterations) << "seed " << seed;
+    EXPECT_NEAR(a.initial_cost, b.initial_cost, 1e-9 * b.initial_cost) << "seed " << seed;
+    EXPECT_NEAR(a.final_cost, b.final_cost, 1e-6 * b.final_cost + 1e-12) << "seed " << seed;
+    for (std::size_t k = 0; k < schur.X_CW.size(); ++k) {
+      EXPECT_LT(poseError(schur.X_CW[k], ceres.X_CW[k]), 1e-8) << "seed " << seed << " keyframe " << k;
+    }
+    for (std::size_t l = 0; l < schur.p_W.size(); ++l) {
+      EXPECT_LT((schur.p_W[l] - ceres.p_W[l]).norm(), 1e-7) << "seed " << seed << " landmark " << l;
+    }
+  }
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <string>
+#include <vector>
 
 namespace tgnav::vo {
 namespace {
@@ -85,6 +87,86 @@ TEST(Odometry, BundleAdjustmentRefinesKeyframesOnly) {
       EXPECT_EQ(adjusted, 0);
     }
   }
+}
+
+// Bundle adjustment in the background (ba.latency_frames = 3): each adjustment is applied 3
+// frames after the keyframe that started it, or after the frame that applied the one before
+// (one in flight at a time); the run tracks the slide as well as adjusting at the keyframe, and
+// two runs give the same poses bit for bit, however the threads were scheduled. Keyframes name
+// the rule that made them.
+TEST(Odometry, BackgroundBundleAdjustmentLandsAFixedNumberOfFramesLater) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  OdometryConfig config;
+  config.ba.latency_frames = 3;
+  std::vector<std::vector<FrameResult>> runs;
+  for (int run = 0; run < 2; ++run) {
+    RgbdOdometry vo(camera(), config);
+    std::vector<FrameResult> results;
+    for (int i = 0; i < 100; ++i) {
+      results.push_back(vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth()));
+      const FrameResult& r = results.back();
+      ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+      const double truth = 4.0 * i * kDepth / kF;
+      EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 8e-3) << "frame " << i;
+      EXPECT_EQ(r.keyframe, !r.keyframe_rule.empty()) << "frame " << i;
+    }
+    runs.push_back(std::move(results));
+  }
+  const std::vector<FrameResult>& r = runs[0];
+  EXPECT_EQ(r[0].keyframe_rule, "first");
+  int applied = 0;
+  long due = -1;  // frame at which the adjustment in flight lands
+  bool queued = false;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    const bool lands = std::isfinite(r[i].ba_correction_m);
+    EXPECT_EQ(lands, static_cast<long>(i) == due) << "frame " << i;
+    if (lands) {
+      ++applied;
+      due = queued ? static_cast<long>(i) + 3 : -1;
+      queued = false;
+    }
+    if (i > 0 && r[i].keyframe) {
+      if (due < 0) {
+        due = static_cast<long>(i) + 3;
+      } else if (static_cast<long>(i) != due || !lands) {
+        queued = true;
+      }
+    }
+    EXPECT_TRUE(runs[1][i].X_WC.matrix() == r[i].X_WC.matrix()) << "frame " << i;
+  }
+  EXPECT_GE(applied, 5);
+}
+
+// ORB-SLAM2's keyframe policy: a keyframe when the frame tracks too few of the reference
+// keyframe's well-observed landmarks ("reference"), or too few close ones while many close
+// features are new ("close"). The slide over a plane 2 m ahead (all close) tracks with fewer
+// keyframes than the ratio rule takes, each named by its rule.
+TEST(Odometry, OrbSlam2KeyframePolicy) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  int keyframes[2] = {0, 0};
+  for (const KeyframePolicy policy : {KeyframePolicy::kRatio, KeyframePolicy::kOrbSlam2}) {
+    OdometryConfig config;
+    config.keyframe_policy = policy;
+    RgbdOdometry vo(camera(), config);
+    for (int i = 0; i < 100; ++i) {
+      const FrameResult r = vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth());
+      ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+      const double truth = 4.0 * i * kDepth / kF;
+      EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.02 * truth + 0.01) << "frame " << i;
+      if (!r.keyframe || i == 0) continue;
+      ++keyframes[policy == KeyframePolicy::kRatio ? 0 : 1];
+      if (policy == KeyframePolicy::kOrbSlam2) {
+        EXPECT_TRUE(r.keyframe_rule == "reference" || r.keyframe_rule == "close" ||
+                    r.keyframe_rule == "reference+close")
+            << r.keyframe_rule;
+      } else {
+        const auto has = [&](const char* rule) { return r.keyframe_rule.find(rule) != std::string::npos; };
+        EXPECT_TRUE(has("inliers") || has("translation") || has("rotation")) << r.keyframe_rule;
+      }
+    }
+  }
+  EXPECT_GT(keyframes[1], 2);
+  EXPECT_LT(keyframes[1], keyframes[0]) << keyframes[0] << " ratio keyframes";
 }
 
 // The local map keeps a landmark while a keyframe in it observed the landmark, not only while
