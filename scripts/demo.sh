@@ -9,6 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/setup.sh"
 out="$root/results/demo"
+echo "demo: running the trial (tgnav trial, storage, proposed planner; the feature map is built on first use)" >&2
 "$root/build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" --planner proposed \
   --out "$out" --force "$@"
 for f in metrics.json gt.tum est.tum plan.json config.yaml topdown.png ate.png vo.csv trajectory.csv; do
