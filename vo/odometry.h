@@ -240,7 +240,7 @@ class RgbdOdometry {
   // Their parts.
   bool backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const;
   int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
-                 const std::vector<cv::Point2d>& pixels_in, cv::Mat rvec, cv::Mat tvec, Eigen::Isometry3d* X_CW,
+                 const std::vector<cv::Point2d>& pixels_in, const Eigen::Isometry3d& start, Eigen::Isometry3d* X_CW,
                  std::vector<bool>* is_inlier) const;
   // The keyframe rules that fire ('+'-joined; empty: none): ratioRules for the current pose and
   // inliers, orbSlam2Rules also from the frame's close features, tracked or not.

@@ -160,11 +160,23 @@ class ClosedLoop {
     return landed;
   }
 
+  // Renders the state after the step on a copy of what the scene is made of (mj_step leaves
+  // bodies, geoms, cameras and lights at the state before its integration, and the physics must
+  // not see them recomputed): the positions, the mocap bodies and the time, from which the
+  // kinematics, the centres of mass and the cameras and lights follow. Copying the whole mjData
+  // (its arena) every frame cost more than drawing at 320x240.
   RgbdFrame render() {
-    mj_copyData(view_.get(), model_.get(), data_.get());
-    mj_kinematics(model_.get(), view_.get());
-    mj_camlight(model_.get(), view_.get());
-    return camera_.renderNoiseless(view_.get());
+    const mjModel* m = model_.get();
+    const mjData* d = data_.get();
+    mjData* v = view_.get();
+    v->time = d->time;
+    mju_copy(v->qpos, d->qpos, m->nq);
+    mju_copy(v->mocap_pos, d->mocap_pos, 3 * m->nmocap);
+    mju_copy(v->mocap_quat, d->mocap_quat, 4 * m->nmocap);
+    mj_kinematics(m, v);
+    mj_comPos(m, v);
+    mj_camlight(m, v);
+    return camera_.renderNoiseless(v);
   }
 
   std::string afterStep(const FlightLoop& l) {
@@ -324,7 +336,7 @@ class ClosedLoop {
   VehicleModel vehicle_;  // its model moves to model_
   ModelPtr model_;
   DataPtr data_;
-  DataPtr view_;
+  DataPtr view_;  // what the camera renders (render())
   VehicleIds ids_;
   planner::Pose4 landed_;
   FlightLoop loop_;
