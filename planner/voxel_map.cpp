@@ -132,6 +132,11 @@ bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {
 }
 
 std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
+  return visibleFrom(p_W, config, nullptr);
+}
+
+std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                                       const std::function<bool(const LandmarkVoxel&)>& keep) const {
   std::vector<int> visible;
   const double tan_half_vfov = std::tan(0.5 * config.vfov_rad);
   const double min2 = config.min_range_m * config.min_range_m;
@@ -141,6 +146,7 @@ std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const Visibil
     const double r2 = d.squaredNorm();
     if (r2 < min2 || r2 > max2) continue;
     if (std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
+    if (keep && !keep(v)) continue;
     if (!lineOfSight(p_W, v.index)) continue;
     visible.insert(visible.end(), v.ids.begin(), v.ids.end());
   }

@@ -9,6 +9,7 @@
 // line of sight stops only at occupied voxels (unknown is ignored, as in FeatureMap).
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "planner/feature_map.h"
@@ -54,6 +55,10 @@ class VoxelMap {
   // V(p): landmarks within range and the vertical FoV of a camera at p (any yaw) whose voxel is
   // the first occupied voxel on the segment from p to its centre. Sorted ascending.
   std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
+  // The same among the voxels `keep` accepts, asked before the (costly) line of sight: e.g. those
+  // in one yaw's horizontal field of view, for a caller that looks at one yaw only.
+  std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                               const std::function<bool(const LandmarkVoxel&)>& keep) const;
   // True if the first occupied voxel from p towards voxel `index` is that voxel.
   bool lineOfSight(const Eigen::Vector3d& p_W, int index) const;
 

@@ -4,9 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
-#include <cmath>
 #include <random>
 
 namespace tgnav::vo {
