@@ -4,7 +4,8 @@
 # the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
 # storage and gallery with every planner (results/bench/plans/), which also times trajectory
 # generation on the chosen paths, runs closed-loop trials (results/bench/trials/) for their
-# wall time, real-time factor and peak memory, and the smoke sweep with --jobs 1 and --jobs 2
+# wall time, real-time factor, CPU seconds per simulated second of each stage and peak memory,
+# and the smoke sweep with --jobs 1 and --jobs 2
 # (results/bench/sweep-jobs*/) for the sweep throughput.
 # Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
@@ -47,17 +48,20 @@ for scene in storage gallery; do
 done
 
 # Closed-loop trials: storage, proposed planner (the VO tracks the whole flight, so every frame is
-# rendered and tracked), at 640x480 and 320x240, camera and VO at 20 Hz, the three stages pipelined.
+# rendered and tracked), at 640x480 and 320x240, camera and VO at 20 Hz, the three stages pipelined;
+# TRIAL_RUNS runs of each (default 3), reported as their median.
 rm -rf "$out/trials"
 for size in 640x480 320x240; do
-  "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" --map "$out/maps/storage" \
-    --planner proposed --seed 1 --set camera.width_px="${size%x*}" --set camera.height_px="${size#*x}" \
-    --out "$out/trials/storage-proposed-$size" >&2
+  for run in $(seq "${TRIAL_RUNS:-3}"); do
+    "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" --map "$out/maps/storage" \
+      --planner proposed --seed 1 --set camera.width_px="${size%x*}" --set camera.height_px="${size#*x}" \
+      --out "$out/trials/storage-proposed-$size/run$run" >&2
+  done
 done
 # The same 640x480 trial with MuJoCo's default 4x multisampling (the default before issue 21).
 "$build/harness/tgnav" trial --scenario "$root/configs/scenarios/storage.yaml" \
   --map "$out/maps/storage" --planner proposed --seed 1 --set camera.offscreen_samples=4 \
-  --out "$out/trials/storage-proposed-640x480-msaa4" >&2
+  --out "$out/trials/storage-proposed-640x480-msaa4/run1" >&2
 
 # Sweep throughput: the smoke sweep (6 trials, each single-threaded) one and two at a time.
 for jobs in 1 2; do
@@ -91,14 +95,33 @@ for key, runs in groups.items():
     trajectory_s = sorted(p["timing"]["trajectory_s"] for p in runs)
     rows.append({"benchmark": f"plan/{key}", "figure": "median_traj_s", "value": trajectory_s[len(trajectory_s) // 2]})
 trials = os.path.join(out, "trials")
+renderer = None
+def median(values):
+    values = sorted(values)
+    return values[len(values) // 2] if len(values) % 2 else 0.5 * (values[len(values) // 2 - 1] + values[len(values) // 2])
 for run in sorted(os.listdir(trials)) if os.path.isdir(trials) else []:
-    m = json.load(open(os.path.join(trials, run, "metrics.json")))
+    runs = [json.load(open(os.path.join(trials, run, r, "metrics.json")))
+            for r in sorted(os.listdir(os.path.join(trials, run)))]
+    # Wall-clock figures and CPU per simulated second: the median over the runs; the wall-clock
+    # profile below is the median run's (by real-time factor).
+    rows.append({"benchmark": f"trial/{run}", "figure": "runs", "value": len(runs)})
     for figure in ("wall_time_s", "flight_wall_s", "real_time_factor", "peak_rss_mb"):
-        rows.append({"benchmark": f"trial/{run}", "figure": figure, "value": m["timing"][figure]})
+        rows.append({"benchmark": f"trial/{run}", "figure": figure, "value": median([m["timing"][figure] for m in runs])})
+    rtfs = [m["timing"]["real_time_factor"] for m in runs]
+    rows.append({"benchmark": f"trial/{run}", "figure": "rtf_min", "value": min(rtfs)})
+    rows.append({"benchmark": f"trial/{run}", "figure": "rtf_max", "value": max(rtfs)})
+    cpu_runs = [m["timing"].get("profile", {}).get("cpu_per_sim_second_s") for m in runs]
+    if all(cpu_runs):
+        for stage in cpu_runs[0]:
+            values = [c[stage] for c in cpu_runs if c[stage] is not None]
+            if values:
+                rows.append({"benchmark": f"trial/{run}/cpu_s_per_sim_s", "figure": stage, "value": median(values)})
+    m = sorted(runs, key=lambda m: m["timing"]["real_time_factor"])[len(runs) // 2]
     # The per-stage profile (metrics.json timing.profile): ms per camera frame of each stage,
     # per-thread totals and the critical path against the flight's wall time.
     profile = m["timing"].get("profile")
     if profile:
+        renderer = renderer or profile.get("gl_renderer")
         for stage, ms in profile["per_frame_ms"].items():
             rows.append({"benchmark": f"trial/{run}/frame", "figure": f"ms_{stage}", "value": ms})
         for stage, ms in profile["per_sim_second_ms"].items():
@@ -133,12 +156,19 @@ for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "b
                 rows.append({"benchmark": b["name"], "figure": key, "value": value})
         if b["name"].startswith("BM_GridPreprocess"):  # a grid map's graph, built once per map and radius
             rows.append({"benchmark": b["name"], "figure": "ms_preprocess", "value": b["real_time"]})
-meta = {"git_sha": sha, "host": socket.gethostname(), "cpus": os.cpu_count(),
-        "date": datetime.datetime.now().isoformat(timespec="seconds")}
+cpu_model = "unknown"
+if os.path.exists("/proc/cpuinfo"):
+    for line in open("/proc/cpuinfo"):
+        if line.startswith("model name"):
+            cpu_model = line.split(":", 1)[1].strip()
+            break
+meta = {"git_sha": sha, "host": socket.gethostname(), "cpus": os.cpu_count(), "cpu_model": cpu_model,
+        "gl_renderer": renderer, "date": datetime.datetime.now().isoformat(timespec="seconds")}
 print(f"tgnav benchmarks  sha {meta['git_sha']}  host {meta['host']} ({meta['cpus']} cpus)  {meta['date']}")
-print(f"{'benchmark':<34} {'figure':<16} {'value':>10}")
+print(f"cpu: {cpu_model}; renderer: {renderer}")
+print(f"{'benchmark':<44} {'figure':<22} {'value':>10}")
 for r in rows:
-    print(f"{r['benchmark']:<34} {r['figure']:<16} {r['value']:>10.3f}")
+    print(f"{r['benchmark']:<44} {r['figure']:<22} {r['value']:>10.3f}")
 with open(os.path.join(out, "bench.json.tmp"), "w") as f:
     json.dump({"meta": meta, "figures": rows}, f, indent=2)
 os.replace(os.path.join(out, "bench.json.tmp"), os.path.join(out, "bench.json"))

@@ -253,6 +253,7 @@ class ClosedLoop {
     p.waits_for_pose = fly_on_vo_;
     const char* lp = std::getenv("LP_NUM_THREADS");
     p.llvmpipe_threads = lp != nullptr ? std::atoi(lp) : 0;
+    p.gl_renderer = gl_.renderer();
     p.opencv_threads = cv::getNumThreads();
     p.flight_wall_s = result_->flight_wall_s;
     p.sim_time_s = result_->sim_time_s;

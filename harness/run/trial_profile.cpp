@@ -114,6 +114,7 @@ nlohmann::ordered_json TrialProfile::toJson() const {
   j["pipelined"] = pipelined;
   j["queue_capacity"] = queue_capacity;
   j["waits_for_pose"] = waits_for_pose;
+  j["gl_renderer"] = gl_renderer;
   j["llvmpipe_threads"] = llvmpipe_threads;
   j["opencv_threads"] = opencv_threads;
   j["camera_ticks"] = ticks.size();

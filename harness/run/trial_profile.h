@@ -7,6 +7,7 @@
 // None of it is deterministic, and none of it feeds a result that must repeat (metrics.json
 // `timing.profile`).
 #include <nlohmann/json.hpp>
+#include <string>
 #include <vector>
 
 #include "harness/sim/camera.h"
@@ -33,6 +34,7 @@ struct TrialProfile {
   bool pipelined = false;        // features and tracking on threads of their own (trial.pipeline)
   int queue_capacity = 0;        // frames each stage may queue for the next (pipelined)
   bool waits_for_pose = false;   // the controller flies on the VO: tick k waits for frame k-1's pose
+  std::string gl_renderer;       // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)" (the machine's renderer)
   int llvmpipe_threads = 0;      // LP_NUM_THREADS as the renderer saw it (0: unset, llvmpipe's default)
   int opencv_threads = 0;        // cv::getNumThreads()
   double flight_wall_s = 0.0;    // the flight's wall time, which the ticks add up to
