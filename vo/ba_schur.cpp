@@ -212,8 +212,9 @@ void Solver::linearise() {
     for (int i : layout_.observations_of[j]) {
       const auto ui = static_cast<std::size_t>(i);
       const int slot = poseSlot(i);
-      if (slot >= 0)
+      if (slot >= 0) {
         cross_blocks_[ui] = scale_.segment<6>(poseColumn(slot)).asDiagonal() * cross_blocks_[ui] * sl.asDiagonal();
+      }
     }
   }
 }

@@ -49,7 +49,7 @@ std::string RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const Local
       ++landmarks_[l].misses;
     }
   }
-  const std::string keyframe = config_.keyframe_policy == KeyframePolicy::kRatio
+  std::string keyframe = config_.keyframe_policy == KeyframePolicy::kRatio
                                    ? ratioRules(pose.inliers)
                                    : orbSlam2Rules(pose.inliers, frame, matched_landmark);
   if (!keyframe.empty()) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);

@@ -175,6 +175,8 @@ class RgbdOdometry {
   ~RgbdOdometry();  // waits for a bundle adjustment in flight
   RgbdOdometry(const RgbdOdometry&) = delete;
   RgbdOdometry& operator=(const RgbdOdometry&) = delete;
+  RgbdOdometry(RgbdOdometry&&) = delete;
+  RgbdOdometry& operator=(RgbdOdometry&&) = delete;
 
   // A frame's keypoints with their descriptors and 3D points: all track() needs of the images.
   // Preparing does not depend on the odometry's state, so one thread may prepare the next frames
