@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <utility>
 
 #include "planner/check.h"
 
@@ -25,19 +25,27 @@ double ViewSupport::coverage() const {
   return static_cast<double>(__builtin_popcountll(cells)) / (kImageCols * kImageRows);
 }
 
-int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
-              const VisibilityConfig& visibility) {
+ImageCells::ImageCells(double yaw_rad, const VisibilityConfig& visibility)
+    : cos_yaw_(std::cos(yaw_rad)),
+      sin_yaw_(std::sin(yaw_rad)),
+      tan_half_hfov_(std::tan(0.5 * visibility.hfov_rad)),
+      tan_half_vfov_(std::tan(0.5 * visibility.vfov_rad)) {}
+
+int ImageCells::operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const {
   const Eigen::Vector3d d = l_W - p_W;
-  const double c = std::cos(yaw_rad);
-  const double s = std::sin(yaw_rad);
-  const double forward = c * d.x() + s * d.y();
-  const double left = -s * d.x() + c * d.y();
+  const double forward = cos_yaw_ * d.x() + sin_yaw_ * d.y();
+  const double left = -sin_yaw_ * d.x() + cos_yaw_ * d.y();
   if (forward <= 0.0) return -1;
-  const double u = -left / forward / std::tan(0.5 * visibility.hfov_rad);   // -1 left edge, +1 right
-  const double v = -d.z() / forward / std::tan(0.5 * visibility.vfov_rad);  // -1 top, +1 bottom
+  const double u = -left / forward / tan_half_hfov_;   // -1 left edge, +1 right
+  const double v = -d.z() / forward / tan_half_vfov_;  // -1 top, +1 bottom
   const int col = std::clamp(static_cast<int>(std::floor(0.5 * (u + 1.0) * kImageCols)), 0, kImageCols - 1);
   const int row = std::clamp(static_cast<int>(std::floor(0.5 * (v + 1.0) * kImageRows)), 0, kImageRows - 1);
   return row * kImageCols + col;
+}
+
+int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
+              const VisibilityConfig& visibility) {
+  return ImageCells(yaw_rad, visibility)(p_W, l_W);
 }
 
 bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, const InformationConfig& config) {
@@ -71,19 +79,34 @@ double rankedScore(double score, const ViewSupport& support, const InformationCo
 }
 
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids) {
-  std::map<int, std::pair<int, double>> count;  // slot -> landmarks, detections
+  std::vector<std::pair<int, int>> keyed;  // (slot, id), grouped by slot below in ids' order
+  keyed.reserve(ids.size());
   for (int id : ids) {
     const int slot = voxels.landmarkSlot(id);
-    if (slot < 0) continue;
-    auto& [n, detections] = count[slot];
-    ++n;
-    detections += voxels.detectability(id);
+    if (slot >= 0) keyed.emplace_back(slot, id);
   }
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<WeightedPoint> points;
-  points.reserve(count.size());
-  for (const auto& [slot, sums] : count) {
+  for (std::size_t i = 0; i < keyed.size();) {
+    const int slot = keyed[i].first;
+    int n = 0;
+    double detections = 0.0;
+    for (; i < keyed.size() && keyed[i].first == slot; ++i) {
+      ++n;
+      detections += voxels.detectability(keyed[i].second);
+    }
     const LandmarkVoxel& v = voxels.landmarkVoxels()[static_cast<std::size_t>(slot)];
-    points.push_back({v.mean_W, static_cast<double>(sums.first), v.normal_W, sums.second});
+    points.push_back({v.mean_W, static_cast<double>(n), v.normal_W, detections});
+  }
+  return points;
+}
+
+std::vector<WeightedPoint> aggregateSlots(const VoxelMap& voxels, const std::vector<int>& slots) {
+  std::vector<WeightedPoint> points;
+  points.reserve(slots.size());
+  for (int slot : slots) {
+    const LandmarkVoxel& v = voxels.landmarkVoxels().at(static_cast<std::size_t>(slot));
+    points.push_back({v.mean_W, static_cast<double>(v.ids.size()), v.normal_W, v.detections});
   }
   return points;
 }
@@ -103,10 +126,11 @@ Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::
                          const VisibilityConfig& visibility, const InformationConfig& config, ViewSupport* support) {
   Matrix6d info = Matrix6d::Zero();
   ViewSupport view;
+  const ImageCells cell(yaw_rad, visibility);
   for (const WeightedPoint& pt : points) {
     if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
-      view.add(pt, imageCell(p_W, yaw_rad, pt.p_W, visibility));
+      view.add(pt, cell(p_W, pt.p_W));
     }
   }
   if (support != nullptr) *support = view;

@@ -101,6 +101,19 @@ struct ViewSupport {
 int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
               const VisibilityConfig& visibility);
 
+// imageCell() for many points seen along one yaw: the trigonometry once (the same cells).
+class ImageCells {
+ public:
+  ImageCells(double yaw_rad, const VisibilityConfig& visibility);
+  int operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const;
+
+ private:
+  double cos_yaw_;
+  double sin_yaw_;
+  double tan_half_hfov_;
+  double tan_half_vfov_;
+};
+
 // The score of a pose from its information and what backs it: log det (I + eps Id), or the blind
 // score 6 ln eps when fewer than config.min_landmarks count, they promise fewer than
 // config.min_detections detections or they cover less of the image than config.min_image_coverage.
@@ -120,6 +133,19 @@ double rankedScore(double score, const ViewSupport& support, const InformationCo
 // The candidate landmarks `ids` grouped by their voxel in `voxels` (weight: their number;
 // detections: their summed detectability); ids outside its box are left out.
 std::vector<WeightedPoint> aggregateByVoxel(const VoxelMap& voxels, const std::vector<int>& ids);
+// The same for whole voxels, given as ascending indices into voxels.landmarkVoxels() (e.g.
+// VoxelMap::visibleSlots): equal to aggregateByVoxel() of the union of their ids.
+std::vector<WeightedPoint> aggregateSlots(const VoxelMap& voxels, const std::vector<int>& slots);
+
+// std::atan2(opposite, adjacent) <= half_angle (both sides >= 0, half_angle in (0, pi/2)), the
+// arctangent skipped where comparing opposite with tan_half_angle * adjacent decides by a margin
+// (1e-9 relative) far beyond both functions' rounding: the same answer, mostly without atan2.
+inline bool withinHalfAngle(double opposite, double adjacent, double half_angle, double tan_half_angle) {
+  const double edge = tan_half_angle * adjacent;
+  if (opposite < edge * (1.0 - 1e-9)) return true;
+  if (opposite > edge * (1.0 + 1e-9)) return false;
+  return std::atan2(opposite, adjacent) <= half_angle;
+}
 
 // True if a level camera at p_W looking along yaw_rad sees l_W within range and both FoVs.
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,

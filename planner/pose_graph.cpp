@@ -36,7 +36,7 @@ std::vector<bool> startTurnAllowed(const Eigen::Vector3d& start, const std::vect
                                    const VoxelMap& voxels, const VisibilityConfig& visibility,
                                    const InformationConfig& information, double floor) {
   const int yaws = static_cast<int>(yaw_of.size());
-  const std::vector<WeightedPoint> points = aggregateByVoxel(voxels, voxels.visibleFrom(start, visibility));
+  const std::vector<WeightedPoint> points = aggregateSlots(voxels, voxels.visibleSlots(start, visibility));
   std::vector<double> view(yaw_of.size());
   for (int k = 0; k < yaws; ++k) {
     view[static_cast<std::size_t>(k)] =
@@ -80,14 +80,24 @@ void PoseGraphConfig::validate() const {
 }
 
 DagPath shortestLayeredPath(const LayeredDag& dag) {
+  DagMemo memo;
+  return shortestLayeredPath(dag, &memo, 0);
+}
+
+DagPath shortestLayeredPath(const LayeredDag& dag, DagMemo* memo, std::size_t first_changed) {
   DagPath result;
   const std::size_t layers = dag.node_cost.size();
   if (layers == 0) return result;
-  std::vector<std::vector<double>> best(layers);
-  std::vector<std::vector<int>> parent(layers);
-  best[0] = dag.node_cost[0];
-  parent[0].assign(best[0].size(), -1);
-  for (std::size_t j = 0; j + 1 < layers; ++j) {
+  std::vector<std::vector<double>>& best = memo->best;
+  std::vector<std::vector<int>>& parent = memo->parent;
+  if (best.size() != layers) first_changed = 0;
+  best.resize(layers);
+  parent.resize(layers);
+  if (first_changed == 0) {
+    best[0] = dag.node_cost[0];
+    parent[0].assign(best[0].size(), -1);
+  }
+  for (std::size_t j = first_changed; j + 1 < layers; ++j) {
     best[j + 1].assign(dag.node_cost[j + 1].size(), kInf);
     parent[j + 1].assign(dag.node_cost[j + 1].size(), -1);
     for (const LayeredDag::Edge& e : dag.edges[j]) {
@@ -167,8 +177,14 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   result.layer_s.resize(static_cast<std::size_t>(layers));
   result.layer_segment.resize(static_cast<std::size_t>(layers));
   const int half_window = static_cast<int>(std::ceil(0.5 * visibility.hfov_rad / yaw_step)) + 1;
+  const double tan_half_vfov = std::tan(0.5 * visibility.vfov_rad);
   std::vector<double> yaw_of(static_cast<std::size_t>(yaws));
-  for (int k = 0; k < yaws; ++k) yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
+  std::vector<ImageCells> cells_of;
+  cells_of.reserve(static_cast<std::size_t>(yaws));
+  for (int k = 0; k < yaws; ++k) {
+    yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
+    cells_of.emplace_back(yaw_of[static_cast<std::size_t>(k)], visibility);
+  }
   const std::vector<bool> turn_ok =
       free_start && !std::isnan(turn_from_yaw_rad) && config.guard_start_turn && !path.empty()
           ? startTurnAllowed(path.front(), yaw_of, voxels, visibility, information, config.turn_floor)
@@ -204,7 +220,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     auto& layer_cost = dag.node_cost[static_cast<std::size_t>(j)];
     auto& layer_scores = scores[static_cast<std::size_t>(j)];
     auto& seen = layer_seen[static_cast<std::size_t>(j)];
-    if (gate) seen = aggregateByVoxel(voxels, voxels.visibleFrom(centre, visibility));
+    if (gate) seen = aggregateSlots(voxels, voxels.visibleSlots(centre, visibility));
     for (const Eigen::Vector3d& p : candidates) {
       if (voxels.clearance(p) < config.robot_radius_m) continue;
       layer_positions.push_back(p);
@@ -216,17 +232,22 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         const double range = d.norm();
         if (range < visibility.min_range_m || range > visibility.max_range_m) return;
         if (!withinIncidence(p, pt, information)) return;
-        if (std::atan2(std::abs(d.z()), d.head<2>().norm()) > 0.5 * visibility.vfov_rad) return;
+        if (!withinHalfAngle(std::abs(d.z()), d.head<2>().norm(), 0.5 * visibility.vfov_rad, tan_half_vfov)) return;
         const double azimuth = std::atan2(d.y(), d.x());
         const bool all = 2 * half_window + 1 >= yaws;
-        const int nearest = all ? 0 : static_cast<int>(std::lround((azimuth - yaw0) / yaw_step));
+        // The window only has to hold every yaw that can see pt (it has a spare yaw each side),
+        // so the bin nearest the azimuth may round either way; each yaw is then tested exactly.
+        const double bin = (azimuth - yaw0) / yaw_step;
+        const int nearest = all ? 0 : static_cast<int>(bin + (bin >= 0.0 ? 0.5 : -0.5));
         const int first = all ? 0 : nearest - half_window;
         const int last = all ? yaws - 1 : nearest + half_window;
+        int idx = first % yaws;
+        if (idx < 0) idx += yaws;
         for (int k = first; k <= last; ++k) {
-          const int idx = ((k % yaws) + yaws) % yaws;
           if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
             add(static_cast<std::size_t>(idx));
           }
+          if (++idx == yaws) idx = 0;
         }
       };
       // Information per yaw from the segment's co-visible landmarks (eq. 6).
@@ -243,7 +264,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         });
       }
       for (const WeightedPoint& pt : seen) {
-        forYawsHolding(pt, [&](std::size_t idx) { support[idx].cover(imageCell(p, yaw_of[idx], pt.p_W, visibility)); });
+        forYawsHolding(pt, [&](std::size_t idx) { support[idx].cover(cells_of[idx](p, pt.p_W)); });
       }
       for (int k = 0; k < yaws; ++k) {
         const ViewSupport& backing = support[static_cast<std::size_t>(k)];
@@ -307,9 +328,10 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       const Matrix6d info = poseInformation(p, yaw, pointsOf(segmentAt(s)), visibility, information, &backing);
       if (gate) {
         backing.cells = 0;
+        const ImageCells cell(yaw, visibility);
         for (const WeightedPoint& pt : layer_seen[2 * i <= config.between_checks + 1 ? ju : ju + 1]) {
           if (inFieldOfView(p, yaw, pt.p_W, visibility) && withinIncidence(p, pt, information)) {
-            backing.cover(imageCell(p, yaw, pt.p_W, visibility));
+            backing.cover(cell(p, pt.p_W));
           }
         }
       }
@@ -321,10 +343,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     return lowest;
   };
   std::map<std::tuple<int, int, int>, double> checked;  // (layer, from, to) -> checkMove()
-  DagPath best = shortestLayeredPath(dag);
+  DagMemo memo;
+  DagPath best = shortestLayeredPath(dag, &memo, 0);
   result.between_rounds = 1;
   while (config.between_checks > 0 && best.found) {
     bool penalised = false;
+    std::size_t first_penalised = 0;
     for (int j = 0; j + 1 < layers; ++j) {
       const int from = best.nodes[static_cast<std::size_t>(j)];
       const int to = best.nodes[static_cast<std::size_t>(j) + 1];
@@ -338,10 +362,11 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       for (LayeredDag::Edge& e : dag.edges[static_cast<std::size_t>(j)]) {
         if (e.from == from && e.to == to) e.cost += penalty;
       }
+      if (!penalised) first_penalised = static_cast<std::size_t>(j);
       penalised = true;
     }
     if (!penalised || result.between_rounds >= config.max_between_rounds) break;
-    best = shortestLayeredPath(dag);
+    best = shortestLayeredPath(dag, &memo, first_penalised);
     ++result.between_rounds;
   }
   if (!best.found) return result;

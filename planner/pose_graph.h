@@ -120,6 +120,15 @@ struct DagPath {
 // Exact minimum-cost path by dynamic programming in layer order; ties go to the lower index.
 DagPath shortestLayeredPath(const LayeredDag& dag);
 
+// The same, solved again after only edges of layers >= first_changed (edges[j], j >= it) changed:
+// the costs to reach layers <= first_changed are kept in `memo` from the previous call (which
+// must have been on this DAG's layers and nodes). first_changed 0, or an empty memo, solves all.
+struct DagMemo {
+  std::vector<std::vector<double>> best;
+  std::vector<std::vector<int>> parent;
+};
+DagPath shortestLayeredPath(const LayeredDag& dag, DagMemo* memo, std::size_t first_changed);
+
 struct PoseGraphResult {
   bool found = false;
   std::vector<Pose4> path;         // one pose per layer

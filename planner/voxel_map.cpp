@@ -115,18 +115,39 @@ bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {
   }
   if (!inside(c)) return false;
   // Both ends are inside the (convex) box, so every voxel between them is: walk flat indices.
-  const int stride[3] = {step[0], step[1] * size_.x(), step[2] * size_.x() * size_.y()};
+  // The axis and its parameters in scalars (same arithmetic, same order: the same voxels).
+  const int stride_x = step[0];
+  const int stride_y = step[1] * size_.x();
+  const int stride_z = step[2] * size_.x() * size_.y();
+  double tx = t_max[0];
+  double ty = t_max[1];
+  double tz = t_max[2];
+  const double dx = t_delta[0];
+  const double dy = t_delta[1];
+  const double dz = t_delta[2];
+  const VoxelState* state = state_.data();
+  const int voxels = static_cast<int>(state_.size());
   int idx = flat(c.x(), c.y(), c.z());
   const int remaining = (goal - c).cwiseAbs().sum();
   for (int n = 0; n <= remaining; ++n) {
     if (idx == index) return true;
-    if (state_[static_cast<std::size_t>(idx)] == VoxelState::kOccupied) return false;
-    int k = 0;
-    if (t_max[1] < t_max[k]) k = 1;
-    if (t_max[2] < t_max[k]) k = 2;
-    idx += stride[k];
-    t_max[k] += t_delta[k];
-    if (idx < 0 || idx >= static_cast<int>(state_.size())) return false;
+    if (state[idx] == VoxelState::kOccupied) return false;
+    if (ty < tx) {
+      if (tz < ty) {
+        idx += stride_z;
+        tz += dz;
+      } else {
+        idx += stride_y;
+        ty += dy;
+      }
+    } else if (tz < tx) {
+      idx += stride_z;
+      tz += dz;
+    } else {
+      idx += stride_x;
+      tx += dx;
+    }
+    if (idx < 0 || idx >= voxels) return false;
   }
   return false;  // numerical miss of the target voxel: treat as not seen
 }
@@ -135,23 +156,46 @@ std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const Visibil
   return visibleFrom(p_W, config, nullptr);
 }
 
-std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
-                                       const std::function<bool(const LandmarkVoxel&)>& keep) const {
-  std::vector<int> visible;
+namespace {
+
+// Calls visit(slot) for each landmark voxel within range and the vertical FoV of p that `keep`
+// accepts (when given) and p sees, in slot order.
+template <typename Visit>
+void forVisibleVoxels(const VoxelMap& map, const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                      const std::function<bool(const LandmarkVoxel&)>* keep, Visit&& visit) {
   const double tan_half_vfov = std::tan(0.5 * config.vfov_rad);
   const double min2 = config.min_range_m * config.min_range_m;
   const double max2 = config.max_range_m * config.max_range_m;
-  for (const LandmarkVoxel& v : landmark_voxels_) {
+  const std::vector<LandmarkVoxel>& voxels = map.landmarkVoxels();
+  for (std::size_t slot = 0; slot < voxels.size(); ++slot) {
+    const LandmarkVoxel& v = voxels[slot];
     const Eigen::Vector3d d = v.centre_W - p_W;
     const double r2 = d.squaredNorm();
     if (r2 < min2 || r2 > max2) continue;
     if (std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
-    if (keep && !keep(v)) continue;
-    if (!lineOfSight(p_W, v.index)) continue;
-    visible.insert(visible.end(), v.ids.begin(), v.ids.end());
+    if (keep != nullptr && *keep && !(*keep)(v)) continue;
+    if (!map.lineOfSight(p_W, v.index)) continue;
+    visit(slot);
   }
+}
+
+}  // namespace
+
+std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                                       const std::function<bool(const LandmarkVoxel&)>& keep) const {
+  std::vector<int> visible;
+  forVisibleVoxels(*this, p_W, config, &keep, [&](std::size_t slot) {
+    const std::vector<int>& ids = landmark_voxels_[slot].ids;
+    visible.insert(visible.end(), ids.begin(), ids.end());
+  });
   std::sort(visible.begin(), visible.end());
   return visible;
+}
+
+std::vector<int> VoxelMap::visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
+  std::vector<int> slots;
+  forVisibleVoxels(*this, p_W, config, nullptr, [&](std::size_t slot) { slots.push_back(static_cast<int>(slot)); });
+  return slots;
 }
 
 void VoxelMap::computeDistanceField() {

@@ -59,6 +59,9 @@ class VoxelMap {
   // in one yaw's horizontal field of view, for a caller that looks at one yaw only.
   std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
                                const std::function<bool(const LandmarkVoxel&)>& keep) const;
+  // The same as indices into landmarkVoxels() (ascending): visibility is decided per voxel, so
+  // V(p) is the union of these voxels' ids.
+  std::vector<int> visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
   // True if the first occupied voxel from p towards voxel `index` is that voxel.
   bool lineOfSight(const Eigen::Vector3d& p_W, int index) const;
 

@@ -2,8 +2,8 @@
 # Builds the Google Benchmark targets (build-bench/, Release) and prints one table of figures
 # with git SHA, host and date; writes the same as JSON to results/bench/bench.json. Also builds
 # the feature map of every scene (results/bench/maps/) to time the mapping run, and plans on
-# storage and gallery with every planner (results/bench/plans/), which also times trajectory
-# generation on the chosen paths, runs closed-loop trials (results/bench/trials/) for their
+# storage and gallery with every planner and on three generated scenes with the proposed one
+# (results/bench/plans/), which also times trajectory generation on the chosen paths, runs closed-loop trials (results/bench/trials/) for their
 # wall time, real-time factor, CPU seconds per simulated second of each stage and peak memory,
 # and the smoke sweep with --jobs 1 and --jobs 2
 # (results/bench/sweep-jobs*/) for the sweep throughput.
@@ -44,6 +44,19 @@ for scene in storage gallery; do
   for n in $samples; do
     "$build/harness/tgnav" plan --scenario "$root/configs/scenarios/$scene.yaml" --map "$map" \
       --planner rrtstar --samples "$n" --seed 1 --out "$out/plans/$scene-rrtstar$n-s1" >&2
+  done
+done
+
+# Plan time on generated scenes (tgnav scene generate, seed 11 of each kind: a calibration seed,
+# never a benchmark's), the proposed planner over three seeds.
+rm -rf "$out/generated"
+for kind in room corridors warehouse; do
+  gen="$out/generated/$kind"
+  "$build/harness/tgnav" scene generate --kind "$kind" --seed 11 --out "$gen" >&2
+  "$build/harness/tgnav" map --scene "$gen/scenes/$kind-11.yaml" --out "$gen/map" >&2
+  for seed in 1 2 3; do
+    "$build/harness/tgnav" plan --scenario "$gen/scenarios/$kind-11.yaml" --map "$gen/map" --planner proposed \
+      --seed "$seed" --out "$out/plans/$kind-11-proposed-s$seed" >&2
   done
 done
 

@@ -124,6 +124,7 @@ try:
     from matplotlib.cm import ScalarMappable
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
+    from matplotlib.ticker import MaxNLocator
 except ImportError as error:
     MISSING = error
 else:
@@ -663,6 +664,7 @@ def class_label(i, c):
 def draw_quality_bar(fig, ax, scale, threshold):
     bar = fig.colorbar(ScalarMappable(scale[1], scale[0]), ax=ax, location="bottom", shrink=0.6, aspect=35)
     bar.set_label(r"class $c_{p,\min}$ (information of its weakest segment)")
+    bar.ax.xaxis.set_major_locator(MaxNLocator(nbins=6))  # labels that do not run into each other
     if threshold is not None:
         bar.ax.axvline(threshold, color="black", lw=1.5)
         bar.ax.text(threshold, 1.15, r"$c_{p,\mathrm{thr}}$", transform=bar.ax.get_xaxis_transform(), ha="center",

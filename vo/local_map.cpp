@@ -50,8 +50,8 @@ std::string RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const Local
     }
   }
   std::string keyframe = config_.keyframe_policy == KeyframePolicy::kRatio
-                                   ? ratioRules(pose.inliers)
-                                   : orbSlam2Rules(pose.inliers, frame, matched_landmark);
+                             ? ratioRules(pose.inliers)
+                             : orbSlam2Rules(pose.inliers, frame, matched_landmark);
   if (!keyframe.empty()) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
   // Cull landmarks that keep failing to match where they should be seen (after the keyframe
   // step, which indexes landmarks_ through matched_landmark).

@@ -31,10 +31,12 @@ struct PlanOptions {
   int max_classes = 10;
   std::string figure_format = "png";
   std::optional<int> homology_class;
+  std::vector<std::string> set;
 };
 
 harness::PlanJobResult planGrid(const PlanOptions& opt) {
   if (opt.homology_class) throw InputError("--class: only with --scenario (the oracle of a scene's planners)");
+  if (!opt.set.empty()) throw InputError("--set: only with --scenario (overrides of its resolved config)");
   if (!opt.planner.empty() && opt.planner != "agnostic") {
     throw InputError("--planner: '" + opt.planner + "' needs a scene's feature map; with --grid only 'agnostic' runs");
   }
@@ -69,6 +71,7 @@ harness::PlanJobResult planScenario(const PlanOptions& opt) {
   job.out = opt.out;
   job.figure_format = harness::parseFigureFormat(opt.figure_format);
   job.homology_class = opt.homology_class;
+  job.set = opt.set;
   return harness::runScenarioPlan(job);
 }
 
@@ -101,6 +104,9 @@ void addPlanCommand(CLI::App& app) {
   cmd->add_option("--max-classes", opt->max_classes, "--grid: cap on the homology classes searched")
       ->capture_default_str();
   cmd->add_option("--out", opt->out, "Output directory")->required();
+  cmd->add_option("--set", opt->set,
+                  "--scenario: override a setting of the resolved config, e.g. --set planner.perception.c_p_min=-20 "
+                  "(repeatable; keys as in a trial's config.yaml)");
   cmd->add_option("--figure-format", opt->figure_format, "png | pdf | svg")->capture_default_str();
   auto homology_class = std::make_shared<int>(0);
   cmd->add_option("--class", *homology_class, "The oracle: plan homology class K (proposed or agnostic)");

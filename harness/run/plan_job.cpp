@@ -10,6 +10,7 @@
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
 #include "harness/config/values.h"
+#include "harness/config/yaml_util.h"
 #include "harness/io/grid_io.h"
 #include "harness/io/movingai_scen.h"
 #include "harness/io/staged_output.h"
@@ -126,7 +127,7 @@ nlohmann::ordered_json gridPlanJson(const GridPlanJob& job, const planner::Occup
 std::string scenarioSummary(const ScenarioPlanJob& job, const PlanRun& run, const std::filesystem::path& out) {
   const planner::Plan& plan = run.plan;
   const planner::TrajectoryReport& tr = run.trajectory;
-  const std::string files = std::string("{plan.json,plan.") + toString(job.figure_format);
+  const std::string files = std::string("{plan.json,config.yaml,plan.") + toString(job.figure_format);
   char line[1024];
   if (plan.chosen < 0) {
     std::snprintf(line, sizeof line, "tgnav plan: %s %s (no path from start to goal), %.3f s -> %s/%s}",
@@ -148,7 +149,8 @@ std::string scenarioSummary(const ScenarioPlanJob& job, const PlanRun& run, cons
 }  // namespace
 
 PlanJobResult runScenarioPlan(const ScenarioPlanJob& job) {
-  Scenario scenario = loadScenario(job.scenario);
+  const YamlDoc overrides = YamlDoc::fromOverrides(job.set);
+  Scenario scenario = loadScenario(job.scenario, &overrides);
   if (job.homology_class) applyOracleClass(*job.homology_class, job.planner, &scenario);
   const std::uint64_t seed = job.seed.value_or(scenario.seed);
   const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav plan");
@@ -162,6 +164,11 @@ PlanJobResult runScenarioPlan(const ScenarioPlanJob& job) {
     writeFileAtomic(dir / "trajectory.csv", trajectoryCsv(setpoints(run, scenario.planner.trajectory.sample_rate_hz)));
   }
   writeFileAtomic(dir / "plan.json", planJson(scenario, run).dump(2) + "\n");
+  std::string config = "# tgnav plan --planner " + std::string(planner::toString(job.planner));
+  if (job.planner == planner::PlannerKind::kRrtStar) config += " --samples " + std::to_string(run.rrt_samples);
+  config += " --seed " + std::to_string(seed);
+  if (scenario.planner.oracle_class >= 0) config += " --class " + std::to_string(scenario.planner.oracle_class);
+  writeFileAtomic(dir / "config.yaml", config + "\n" + resolvedScenarioYaml(scenario));
   writeMapLayer(dir, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   PlanJobResult result;
   result.figures = drawFigures("plan", dir, job.figure_format);

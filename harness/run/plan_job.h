@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "harness/io/figures.h"
 #include "planner/planner.h"
@@ -25,6 +26,7 @@ struct ScenarioPlanJob {
   std::filesystem::path out;
   FigureFormat figure_format = FigureFormat::kPng;
   std::optional<int> homology_class;  // the oracle: fly this class (planner.oracle_class)
+  std::vector<std::string> set;       // --set dotted.key=value overrides, as `tgnav trial` takes
 };
 
 struct GridPlanJob {

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "planner/perception.h"
 #include "planner/voxel_map.h"
 #include "tests/planner/synthetic_world.h"
 
@@ -212,6 +213,20 @@ TEST(Covisibility, SplitMatchesBruteForceVisibilityOnTheVoxelMap) {
     if (&s == first_drop) break;
     EXPECT_GE(s.ratio, config.covisibility_ratio);
     EXPECT_FALSE(s.covisible.empty());
+  }
+  // V(p) by voxel (VoxelMap::visibleSlots) is the same set: the points aggregated from the
+  // slots equal those aggregated from the ids, bit for bit, everywhere along the path.
+  for (double s = 0.0; s <= 9.0 + 1e-9; s += 0.25) {
+    const Eigen::Vector3d p = pointAt(path, s);
+    const std::vector<WeightedPoint> by_id = aggregateByVoxel(voxels, voxels.visibleFrom(p, vis));
+    const std::vector<WeightedPoint> by_slot = aggregateSlots(voxels, voxels.visibleSlots(p, vis));
+    ASSERT_EQ(by_id.size(), by_slot.size()) << "s = " << s;
+    for (std::size_t i = 0; i < by_id.size(); ++i) {
+      EXPECT_EQ(by_id[i].p_W, by_slot[i].p_W);
+      EXPECT_EQ(by_id[i].weight, by_slot[i].weight);
+      EXPECT_EQ(by_id[i].normal_W, by_slot[i].normal_W);
+      EXPECT_EQ(by_id[i].detections, by_slot[i].detections);
+    }
   }
   std::cout << "[ figure   ] wall end: brute-force visibility change at x = " << change << " (" << before
             << " landmarks seen 0.05 m before), first CR drop in [" << x0 << ", " << x1 << "], " << segs.size()

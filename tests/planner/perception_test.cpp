@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <vector>
 
 namespace tgnav::planner {
@@ -20,6 +21,30 @@ std::vector<WeightedPoint> wall(double y0, double y1, double spacing) {
     for (double z = -0.9; z <= 0.9 + 1e-9; z += spacing) points.push_back({{2.0, y, z}, 1.0, {-1.0, 0.0, 0.0}});
   }
   return points;
+}
+
+// withinHalfAngle() gives std::atan2's answer, at random and on the boundary itself (the
+// vertical FoV's edge, where only the arctangent decides).
+TEST(WithinHalfAngle, AgreesWithTheArctangentEverywhere) {
+  const VisibilityConfig vis;
+  const double half = 0.5 * vis.vfov_rad;
+  const double tan_half = std::tan(half);
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int inside = 0;
+  int outside = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double adjacent = i % 100 == 0 ? 0.0 : 10.0 * unit(rng);
+    // A third of the cases within 3e-9 (relative) of the edge, across the fast tests' margins.
+    const double opposite = i % 3 == 0 ? tan_half * adjacent * (1.0 + 3e-9 * (2.0 * unit(rng) - 1.0))
+                                       : 2.0 * tan_half * adjacent * unit(rng) + (i % 7 == 0 ? unit(rng) : 0.0);
+    const bool expected = std::atan2(opposite, adjacent) <= half;
+    ASSERT_EQ(withinHalfAngle(opposite, adjacent, half, tan_half), expected) << opposite << " " << adjacent;
+    (expected ? inside : outside) += 1;
+  }
+  EXPECT_TRUE(withinHalfAngle(0.0, 0.0, half, tan_half));  // atan2(0, 0) = 0
+  EXPECT_GT(inside, 50000);
+  EXPECT_GT(outside, 50000);
 }
 
 TEST(ImageCell, CornersCentreAndSidesOfTheImage) {

@@ -115,6 +115,51 @@ TEST(LayeredDag, DynamicProgrammeEqualsBruteForceOnRandomDags) {
             << without_path << " without\n";
 }
 
+// The search's lazy rounds raise the cost of edges and solve again from the first layer whose
+// edges changed, keeping the costs to reach the layers before it: the same path and cost as a
+// solve from scratch, ties included.
+TEST(LayeredDag, SolvingAgainFromTheFirstChangedLayerEqualsSolvingFromScratch) {
+  std::mt19937_64 rng(22);
+  std::uniform_int_distribution<int> n_layers(2, 7), n_nodes(1, 5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int compared = 0;
+  for (int g = 0; g < 200; ++g) {
+    LayeredDag dag;
+    const int layers = n_layers(rng);
+    dag.node_cost.resize(static_cast<std::size_t>(layers));
+    dag.edges.resize(static_cast<std::size_t>(layers - 1));
+    for (auto& layer : dag.node_cost) {
+      const int n = n_nodes(rng);
+      for (int k = 0; k < n; ++k) layer.push_back(unit(rng) < 0.1 ? kInf : std::round(4.0 * unit(rng)) - 2.0);
+    }
+    for (int j = 0; j + 1 < layers; ++j) {
+      for (int a = 0; a < static_cast<int>(dag.node_cost[static_cast<std::size_t>(j)].size()); ++a) {
+        for (int b = 0; b < static_cast<int>(dag.node_cost[static_cast<std::size_t>(j + 1)].size()); ++b) {
+          // Whole-number costs: many ties.
+          if (unit(rng) < 0.7) dag.edges[static_cast<std::size_t>(j)].push_back({a, b, std::round(3.0 * unit(rng))});
+        }
+      }
+    }
+    DagMemo memo;
+    DagPath got = shortestLayeredPath(dag, &memo, 0);
+    for (int round = 0; round < 5; ++round) {
+      const auto first = static_cast<std::size_t>(std::uniform_int_distribution<int>(0, layers - 2)(rng));
+      for (std::size_t j = first; j + 1 < static_cast<std::size_t>(layers); ++j) {
+        for (LayeredDag::Edge& e : dag.edges[j]) {
+          if (unit(rng) < 0.3) e.cost += std::round(2.0 * unit(rng));
+        }
+      }
+      got = shortestLayeredPath(dag, &memo, first);
+      const DagPath fresh = shortestLayeredPath(dag);
+      ASSERT_EQ(got.found, fresh.found) << "graph " << g << " round " << round;
+      EXPECT_EQ(got.cost, fresh.cost) << "graph " << g << " round " << round;
+      EXPECT_EQ(got.nodes, fresh.nodes) << "graph " << g << " round " << round;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 1000);
+}
+
 TEST(LayeredDag, TiesGoToTheLowerIndexAndEmptyGraphsHaveNoPath) {
   LayeredDag dag;
   dag.node_cost = {{0.0, 0.0}, {1.0, 1.0, 1.0}, {0.0, 0.0}};

@@ -271,6 +271,26 @@ TEST(SmokeTrialCli, OracleClassIsCheckedAndRecorded) {
   }
 }
 
+// tgnav plan takes --set as tgnav trial does: the override is planned with and recorded in the
+// plan's config.yaml; an unknown key is one line, exit 2, nothing written.
+TEST(SmokeTrialCli, PlanTakesSetOverrides) {
+  const auto dir = tempDir();
+  const std::string plan = std::string(TGNAV_BIN) + " plan --scenario " + kScenario + " --map-cache " +
+                           TGNAV_TEST_CACHE + " --planner agnostic ";
+  CmdResult run = shell(plan + "--set planner.oracle_class=1 --out " + (dir / "p").string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_EQ(nlohmann::json::parse(readText(dir / "p" / "plan.json"))["chosen_topology_class"], 1) << run.output;
+  const std::string config = readText(dir / "p" / "config.yaml");
+  EXPECT_EQ(config.rfind("# tgnav plan --planner agnostic --seed ", 0), 0u) << config;
+  EXPECT_NE(config.find("oracle_class: 1"), std::string::npos) << config;
+
+  run = shell(plan + "--set planner.no_such_key=3 --out " + (dir / "q").string());
+  EXPECT_EQ(run.rc, 2) << run.output;
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("no_such_key"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "q"));
+}
+
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
   const auto out = tempDir() / "trial";
   // A long final hold keeps the vehicle flying when the signal comes (at 320x240 a trial runs
