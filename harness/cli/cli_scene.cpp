@@ -28,7 +28,8 @@ void addSceneCommand(CLI::App& app) {
                                         "scenarios/NAME.yaml, textures; NAME = KIND-SEED) into DIR");
   cmd->add_option("--seed", opt->seed, "Seed: an integer in [0, 2^64 - 1]; the same seed gives the same files")
       ->required();
-  cmd->add_option("--kind", opt->kind, "room (default), corridors or warehouse");
+  cmd->add_option("--kind", opt->kind,
+                  "room (default), corridors, warehouse or detour (the shortest route blind, issue 38)");
   cmd->add_option("--out", opt->out, "Output folder DIR (new or empty)")->required();
   cmd->callback([opt] {
     namespace scenes = harness::scenes;

@@ -53,6 +53,8 @@ const char* toString(SceneKind kind) {
       return "corridors";
     case SceneKind::kWarehouse:
       return "warehouse";
+    case SceneKind::kDetour:
+      return "detour";
   }
   return "?";
 }

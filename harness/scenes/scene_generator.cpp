@@ -25,7 +25,9 @@ SceneKind parseSceneKind(const std::string& text, const std::string& option) {
   if (text == "room") return SceneKind::kRoom;
   if (text == "corridors") return SceneKind::kCorridors;
   if (text == "warehouse") return SceneKind::kWarehouse;
-  throw InputError(option + ": " + quoted(text) + " is not a scene kind; expected room, corridors or warehouse");
+  if (text == "detour") return SceneKind::kDetour;
+  throw InputError(option + ": " + quoted(text) +
+                   " is not a scene kind; expected room, corridors, warehouse or detour");
 }
 
 std::uint64_t parseSceneSeed(const std::string& text, const std::string& option) {
@@ -62,6 +64,9 @@ GeneratedScene generateScene(SceneKind kind, std::uint64_t seed) {
       break;
     case SceneKind::kWarehouse:
       scene.layout = warehouseLayout(seed);
+      break;
+    case SceneKind::kDetour:
+      scene.layout = detourLayout(seed);
       break;
   }
   const std::filesystem::path vehicle = modelsDir() / "quadrotor.xml";

@@ -11,7 +11,7 @@
 
 namespace tgnav::harness::scenes {
 
-enum class SceneKind { kRoom, kCorridors, kWarehouse };
+enum class SceneKind { kRoom, kCorridors, kWarehouse, kDetour };
 enum class TextureLevel { kRich, kMedium, kFaint, kPlain };
 
 const char* toString(SceneKind kind);
@@ -98,9 +98,12 @@ Lighting drawLighting(SceneRng& rng);
 // start's yaw) or around the goal become rich, so a trial can start and end.
 void forceVisibleLevels(Layout& layout);
 
-// --- The kinds (harness/scenes/layout_room.cpp, layout_corridors.cpp) ---
+// --- The kinds (harness/scenes/layout_room.cpp, layout_corridors.cpp, layout_detour.cpp) ---
 Layout roomLayout(std::uint64_t seed);
 Layout corridorsLayout(std::uint64_t seed);
 Layout warehouseLayout(std::uint64_t seed);
+// The paper's premise: the shortest route blind, a longer one flyable by looking beside or behind
+// it (harness/scenes/layout_detour.cpp).
+Layout detourLayout(std::uint64_t seed);
 
 }  // namespace tgnav::harness::scenes

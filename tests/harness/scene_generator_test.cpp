@@ -25,7 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const SceneKind kKinds[] = {SceneKind::kRoom, SceneKind::kCorridors, SceneKind::kWarehouse};
+const SceneKind kKinds[] = {SceneKind::kRoom, SceneKind::kCorridors, SceneKind::kWarehouse, SceneKind::kDetour};
 
 std::string bytesOf(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -155,6 +155,46 @@ TEST(SceneGenerator, EveryKindLoadsCompilesAndKeepsItsGuarantees) {
       });
       EXPECT_TRUE(free_standing);
     }
+  }
+}
+
+// The detour kind keeps the paper's premise from its layout alone: the straight route from start
+// to goal is clear, and from its middle 30 % no ray at the flight height reaches a rich or medium
+// surface within the VO's 10 m; the start's yaw faces texture within 7 m; the goal has some within
+// 5 m; and the levels were drawn, not all set (some surfaces of each kind of level exist).
+TEST(SceneGenerator, DetourKeepsTheShortestRouteBlindAndTheStartTextured) {
+  constexpr double kPi = 3.14159265358979323846;
+  auto textured = [](const Layout& l, int b) {
+    return b >= 0 && (l.blocks[b].level == TextureLevel::kRich || l.blocks[b].level == TextureLevel::kMedium);
+  };
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    SCOPED_TRACE("detour seed " + std::to_string(seed));
+    const Layout l = detourLayout(seed);
+    const double dx = l.goal.x - l.start.x, dy = l.goal.y - l.start.y;
+    for (double f = 0.0; f <= 1.0; f += 0.01) {
+      ASSERT_GE(clearanceAt(l, l.start.x + f * dx, l.start.y + f * dy), kInflationM) << f;
+    }
+    int blind_rays = 0;
+    for (double f = 0.35; f <= 0.65; f += 0.05) {
+      for (int k = 0; k < 360; ++k) {
+        const int hit = firstHit(l, l.start.x + f * dx, l.start.y + f * dy, 2.0 * kPi * k / 360, 10.0);
+        EXPECT_FALSE(textured(l, hit)) << "f " << f << " ray " << k << " hits " << l.blocks[hit].name;
+        ++blind_rays;
+      }
+    }
+    EXPECT_GT(blind_rays, 2000);
+    int start_view = 0;
+    for (int r = -20; r <= 20; ++r) {
+      start_view += textured(l, firstHit(l, l.start.x, l.start.y, l.start.yaw + 37.5 * kPi / 180.0 * r / 20, 7.0));
+    }
+    EXPECT_GE(start_view, 20) << "rays of the start's view on texture, of 41";
+    bool goal_view = false;
+    for (int k = 0; k < 720; ++k) goal_view |= textured(l, firstHit(l, l.goal.x, l.goal.y, 2.0 * kPi * k / 720, 5.0));
+    EXPECT_TRUE(goal_view);
+    int textured_blocks = 0;
+    for (int b = 0; b < static_cast<int>(l.blocks.size()); ++b) textured_blocks += textured(l, b);
+    EXPECT_GT(textured_blocks, 0);
+    EXPECT_LT(textured_blocks, static_cast<int>(l.blocks.size()));
   }
 }
 
