@@ -14,8 +14,9 @@
 //      its view within kRouteViewRangeM (blocks upgraded where needed; the layout is drawn again
 //      when no yaw sees enough such blocks);
 //   3. the start yaw faces such texture in at least half its view (the VO initialises there);
-//      the goal sees some within kGoalViewRangeM. Unlike the other kinds, start and goal views are not made rich all
-//      round: the texture is where the long route passes, beside or behind the direction of travel.
+//      the goal sees some within kGoalViewRangeM.
+// Unlike the other kinds, start and goal views are not made rich all round: the texture is where
+// the long route passes, beside or behind the direction of travel.
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -32,11 +33,12 @@ constexpr int kMaxLayouts = 500;
 constexpr double kBlindRangeM = 10.0;     // the VO's depth range (configs/vo.yaml max_depth_m)
 constexpr double kRouteViewRangeM = 7.0;  // texture the long route keeps in view (as the start)
 constexpr double kGoalViewRangeM = 5.0;
-constexpr double kStartViewRangeM = 7.0;            // texture the VO starts from (its depth range: 10 m)
-constexpr double kHalfFovRad = 37.5 * kPi / 180.0;  // the camera's horizontal half FoV (75 deg)
-constexpr int kRays = 720;                          // all round
-constexpr int kViewRays = 41;                       // across one view
-constexpr int kYaws = 72;                           // the yaws a view is looked for at
+constexpr double kStartViewRangeM = 7.0;  // texture the VO starts from (its depth range: 10 m)
+// The camera's horizontal half FoV (75 deg wide).
+constexpr double kHalfFovRad = 37.5 * kPi / 180.0;
+constexpr int kRays = 720;     // all round
+constexpr int kViewRays = 41;  // across one view
+constexpr int kYaws = 72;      // the yaws a view is looked for at
 constexpr double kStepM = 0.1;
 
 double round1(double v) { return std::round(v * 10.0) / 10.0; }
@@ -232,7 +234,7 @@ Layout detourLayout(std::uint64_t seed) {
     layout.blocks.clear();
     layout.obstacles.clear();
     addOuterWalls(layout, rng);
-    // Start and goal below the middle; the barrier 1.2-1.8 m north of the line between them.
+    // Start and goal below the middle; the barrier 1.3-1.8 m north of the higher of the two.
     const double line_y = rng.uniform(layout.ymin + 1.6, -0.6);
     layout.start = {round2(layout.xmin + 1.4), round2(line_y + rng.uniform(-0.3, 0.3)), 0.0};
     layout.goal = {round2(layout.xmax - 1.4), round2(line_y + rng.uniform(-0.3, 0.3)), 0.0};
