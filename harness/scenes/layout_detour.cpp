@@ -13,8 +13,8 @@
 //      yaw sees rich or medium blocks that the blind stretch cannot see in at least a third of
 //      its view within kRouteViewRangeM (blocks upgraded where needed; the layout is drawn again
 //      when no yaw sees enough such blocks);
-//   3. the start yaw faces such texture in at least half its view (the VO initialises there);
-//      the goal sees some within kGoalViewRangeM.
+//   3. the start's and the goal's yaws face such texture in at least half their view within
+//      kEndViewRangeM (the VO initialises at the start, and the vehicle ends at the goal's yaw).
 // Unlike the other kinds, start and goal views are not made rich all round: the texture is where
 // the long route passes, beside or behind the direction of travel.
 #include <algorithm>
@@ -32,8 +32,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxLayouts = 500;
 constexpr double kBlindRangeM = 10.0;     // the VO's depth range (configs/vo.yaml max_depth_m)
 constexpr double kRouteViewRangeM = 7.0;  // texture the long route keeps in view (as the start)
-constexpr double kGoalViewRangeM = 5.0;
-constexpr double kStartViewRangeM = 7.0;  // texture the VO starts from (its depth range: 10 m)
+constexpr double kEndViewRangeM = 7.0;    // texture at start and goal (the VO's depth range: 10 m)
 // The camera's horizontal half FoV (75 deg wide).
 constexpr double kHalfFovRad = 37.5 * kPi / 180.0;
 constexpr int kRays = 720;     // all round
@@ -156,6 +155,26 @@ bool keepRoutesInView(const Layout& layout, const std::vector<std::vector<Pose2>
   return true;
 }
 
+// Rule 3: the yaw of `pose` (start or goal) whose view holds the most usable blocks within
+// kEndViewRangeM, those blocks made textured; false when under half the view is usable.
+template <typename Usable, typename Upgrade>
+bool faceTexture(const Layout& layout, Pose2* pose, Usable&& usable, Upgrade&& upgrade) {
+  int best_rays = 0;
+  for (int k = 0; k < kRays; ++k) {
+    const double yaw = round2(2.0 * kPi * k / kRays - kPi);
+    const int rays = viewCount(layout, *pose, yaw, kEndViewRangeM, usable);
+    if (rays > best_rays) {
+      best_rays = rays;
+      pose->yaw = yaw;
+    }
+  }
+  if (best_rays < kViewRays / 2) return false;
+  forView(layout, *pose, pose->yaw, kEndViewRangeM, [&](int b) {
+    if (usable(b)) upgrade(b);
+  });
+  return true;
+}
+
 // The premise's rules 1-3 on a layout whose blocks are placed; false when they cannot hold.
 bool keepPremise(Layout& layout, const std::vector<Pose2>& short_route,
                  const std::vector<std::vector<Pose2>>& long_routes, SceneRng& rng) {
@@ -180,36 +199,9 @@ bool keepPremise(Layout& layout, const std::vector<Pose2>& short_route,
   };
   // 2. Texture in view all along the long route.
   if (!keepRoutesInView(layout, long_routes, usable, textured, upgrade)) return false;
-  // 3. Start: the yaw whose view holds the most usable blocks within reach, made textured.
-  int best_rays = 0;
-  for (int k = 0; k < kRays; ++k) {
-    const double yaw = round2(2.0 * kPi * k / kRays - kPi);
-    const int rays = viewCount(layout, layout.start, yaw, kStartViewRangeM, usable);
-    if (rays > best_rays) {
-      best_rays = rays;
-      layout.start.yaw = yaw;
-    }
-  }
-  if (best_rays < kViewRays / 2) return false;
-  forView(layout, layout.start, layout.start.yaw, kStartViewRangeM, [&](int b) {
-    if (usable(b)) upgrade(b);
-  });
-  // ... goal: some usable texture within reach.
-  bool goal_view = false;
-  for (int b : blocksSeen(layout, layout.goal.x, layout.goal.y, kGoalViewRangeM)) {
-    if (usable(b) && texturedLevel(layout.blocks[b].level)) goal_view = true;
-  }
-  if (!goal_view) {
-    int nearest = -1;
-    for (int b : blocksSeen(layout, layout.goal.x, layout.goal.y, kGoalViewRangeM)) {
-      if (usable(b) && (nearest < 0 || distanceTo(layout.blocks[b], layout.goal.x, layout.goal.y) <
-                                           distanceTo(layout.blocks[nearest], layout.goal.x, layout.goal.y))) {
-        nearest = b;
-      }
-    }
-    if (nearest < 0) return false;
-    upgrade(nearest);
-  }
+  // 3. Start and goal face such texture.
+  if (!faceTexture(layout, &layout.start, usable, upgrade)) return false;
+  if (!faceTexture(layout, &layout.goal, usable, upgrade)) return false;
   // Rule 1 again: nothing above may have textured what the stretch sees.
   for (std::size_t b = 0; b < layout.blocks.size(); ++b) {
     if (seen_by_stretch[b] && texturedLevel(layout.blocks[b].level)) return false;

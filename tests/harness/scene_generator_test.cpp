@@ -160,8 +160,8 @@ TEST(SceneGenerator, EveryKindLoadsCompilesAndKeepsItsGuarantees) {
 
 // The detour kind keeps the paper's premise from its layout alone: the straight route from start
 // to goal is clear, and from its middle 30 % no ray at the flight height reaches a rich or medium
-// surface within the VO's 10 m; the start's yaw faces texture within 7 m; the goal has some within
-// 5 m; and the levels were drawn, not all set (some surfaces of each kind of level exist).
+// surface within the VO's 10 m; the start's and the goal's yaws face texture within 7 m in at
+// least half their view; and the levels were drawn, not all set.
 TEST(SceneGenerator, DetourKeepsTheShortestRouteBlindAndTheStartTextured) {
   constexpr double kPi = 3.14159265358979323846;
   auto textured = [](const Layout& l, int b) {
@@ -183,14 +183,12 @@ TEST(SceneGenerator, DetourKeepsTheShortestRouteBlindAndTheStartTextured) {
       }
     }
     EXPECT_GT(blind_rays, 2000);
-    int start_view = 0;
-    for (int r = -20; r <= 20; ++r) {
-      start_view += textured(l, firstHit(l, l.start.x, l.start.y, l.start.yaw + 37.5 * kPi / 180.0 * r / 20, 7.0));
+    for (const Pose2& end : {l.start, l.goal}) {
+      int view = 0;
+      for (int r = -20; r <= 20; ++r)
+        view += textured(l, firstHit(l, end.x, end.y, end.yaw + 37.5 * kPi / 180.0 * r / 20, 7.0));
+      EXPECT_GE(view, 20) << "rays of the view at (" << end.x << ", " << end.y << ") on texture, of 41";
     }
-    EXPECT_GE(start_view, 20) << "rays of the start's view on texture, of 41";
-    bool goal_view = false;
-    for (int k = 0; k < 720; ++k) goal_view |= textured(l, firstHit(l, l.goal.x, l.goal.y, 2.0 * kPi * k / 720, 5.0));
-    EXPECT_TRUE(goal_view);
     int textured_blocks = 0;
     for (int b = 0; b < static_cast<int>(l.blocks.size()); ++b) textured_blocks += textured(l, b);
     EXPECT_GT(textured_blocks, 0);
