@@ -14,7 +14,7 @@
 //      its view within kRouteViewRangeM (blocks upgraded where needed; the layout is drawn again
 //      when no yaw sees enough such blocks);
 //   3. the start's and the goal's yaws face such texture in at least half their view within
-//      kEndViewRangeM (the VO initialises at the start, and the vehicle ends at the goal's yaw).
+//      kEndViewRangeM (the VO initialises in the start's view; RRT* plans to the goal's yaw).
 // Unlike the other kinds, start and goal views are not made rich all round: the texture is where
 // the long route passes, beside or behind the direction of travel.
 #include <algorithm>
