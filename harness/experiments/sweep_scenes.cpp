@@ -73,8 +73,9 @@ std::vector<fs::path> readGeneratedScenes(const YamlDoc& doc, const YAML::Node& 
   }
   std::vector<fs::path> scenarios;
   for (const YAML::Node& entry : items(node)) {
-    if (!entry.IsMap())
+    if (!entry.IsMap()) {
       doc.fail(entry, key + ": expected a mapping {kind: room|corridors|warehouse|detour, seeds: [...]}");
+    }
     doc.requireKeys(entry, {"kind", "seeds"}, key);
     for (const char* k : {"kind", "seeds"}) {
       if (!entry[k]) doc.fail(entry, key + ": key '" + k + "' is missing");
