@@ -152,17 +152,13 @@ bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {
   return false;  // numerical miss of the target voxel: treat as not seen
 }
 
-std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
-  return visibleFrom(p_W, config, nullptr);
-}
-
 namespace {
 
 // Calls visit(slot) for each landmark voxel within range and the vertical FoV of p that `keep`
 // accepts (when given) and p sees, in slot order.
 template <typename Visit>
 void forVisibleVoxels(const VoxelMap& map, const Eigen::Vector3d& p_W, const VisibilityConfig& config,
-                      const std::function<bool(const LandmarkVoxel&)>* keep, Visit&& visit) {
+                      const std::function<bool(const LandmarkVoxel&)>& keep, Visit&& visit) {
   const double tan_half_vfov = std::tan(0.5 * config.vfov_rad);
   const double min2 = config.min_range_m * config.min_range_m;
   const double max2 = config.max_range_m * config.max_range_m;
@@ -173,7 +169,7 @@ void forVisibleVoxels(const VoxelMap& map, const Eigen::Vector3d& p_W, const Vis
     const double r2 = d.squaredNorm();
     if (r2 < min2 || r2 > max2) continue;
     if (std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
-    if (keep != nullptr && *keep && !(*keep)(v)) continue;
+    if (keep && !keep(v)) continue;
     if (!map.lineOfSight(p_W, v.index)) continue;
     visit(slot);
   }
@@ -181,10 +177,9 @@ void forVisibleVoxels(const VoxelMap& map, const Eigen::Vector3d& p_W, const Vis
 
 }  // namespace
 
-std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
-                                       const std::function<bool(const LandmarkVoxel&)>& keep) const {
+std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
   std::vector<int> visible;
-  forVisibleVoxels(*this, p_W, config, &keep, [&](std::size_t slot) {
+  forVisibleVoxels(*this, p_W, config, {}, [&](std::size_t slot) {
     const std::vector<int>& ids = landmark_voxels_[slot].ids;
     visible.insert(visible.end(), ids.begin(), ids.end());
   });
@@ -192,9 +187,10 @@ std::vector<int> VoxelMap::visibleFrom(const Eigen::Vector3d& p_W, const Visibil
   return visible;
 }
 
-std::vector<int> VoxelMap::visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const {
+std::vector<int> VoxelMap::visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                                        const std::function<bool(const LandmarkVoxel&)>& keep) const {
   std::vector<int> slots;
-  forVisibleVoxels(*this, p_W, config, nullptr, [&](std::size_t slot) { slots.push_back(static_cast<int>(slot)); });
+  forVisibleVoxels(*this, p_W, config, keep, [&](std::size_t slot) { slots.push_back(static_cast<int>(slot)); });
   return slots;
 }
 

@@ -55,13 +55,12 @@ class VoxelMap {
   // V(p): landmarks within range and the vertical FoV of a camera at p (any yaw) whose voxel is
   // the first occupied voxel on the segment from p to its centre. Sorted ascending.
   std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
-  // The same among the voxels `keep` accepts, asked before the (costly) line of sight: e.g. those
-  // in one yaw's horizontal field of view, for a caller that looks at one yaw only.
-  std::vector<int> visibleFrom(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
-                               const std::function<bool(const LandmarkVoxel&)>& keep) const;
   // The same as indices into landmarkVoxels() (ascending): visibility is decided per voxel, so
-  // V(p) is the union of these voxels' ids.
-  std::vector<int> visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config) const;
+  // V(p) is the union of these voxels' ids. With `keep`, only among the voxels it accepts, asked
+  // before the (costly) line of sight: e.g. those in one yaw's horizontal field of view, for a
+  // caller that looks at one yaw only.
+  std::vector<int> visibleSlots(const Eigen::Vector3d& p_W, const VisibilityConfig& config,
+                                const std::function<bool(const LandmarkVoxel&)>& keep = {}) const;
   // True if the first occupied voxel from p towards voxel `index` is that voxel.
   bool lineOfSight(const Eigen::Vector3d& p_W, int index) const;
 

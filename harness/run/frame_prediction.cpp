@@ -11,13 +11,13 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   const Eigen::Vector3d forward = X_WC.linear().col(2);
   const double yaw = std::atan2(forward.y(), forward.x());
   // Only the voxels whose landmarks' mean is in this yaw's field of view count in the information
-  // below (planner::inFieldOfView on the mean, which aggregateByVoxel makes each voxel's point):
+  // below (planner::inFieldOfView on the mean, which aggregateSlots makes each voxel's point):
   // the others are left out before their line of sight is traced.
   const auto in_view = [&](const planner::LandmarkVoxel& v) {
     return planner::inFieldOfView(p, yaw, v.mean_W, visibility);
   };
   const std::vector<planner::WeightedPoint> points =
-      planner::aggregateByVoxel(voxels, voxels.visibleFrom(p, visibility, in_view));
+      planner::aggregateSlots(voxels, voxels.visibleSlots(p, visibility, in_view));
   planner::ViewSupport support;
   const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &support);
   FramePrediction out;

@@ -164,11 +164,7 @@ PlanJobResult runScenarioPlan(const ScenarioPlanJob& job) {
     writeFileAtomic(dir / "trajectory.csv", trajectoryCsv(setpoints(run, scenario.planner.trajectory.sample_rate_hz)));
   }
   writeFileAtomic(dir / "plan.json", planJson(scenario, run).dump(2) + "\n");
-  std::string config = "# tgnav plan --planner " + std::string(planner::toString(job.planner));
-  if (job.planner == planner::PlannerKind::kRrtStar) config += " --samples " + std::to_string(run.rrt_samples);
-  config += " --seed " + std::to_string(seed);
-  if (scenario.planner.oracle_class >= 0) config += " --class " + std::to_string(scenario.planner.oracle_class);
-  writeFileAtomic(dir / "config.yaml", config + "\n" + resolvedScenarioYaml(scenario));
+  writeFileAtomic(dir / "config.yaml", runConfigYaml("plan", scenario, run));
   writeMapLayer(dir, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   PlanJobResult result;
   result.figures = drawFigures("plan", dir, job.figure_format);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include "harness/base/errors.h"
 #include "planner/perception_planner.h"
@@ -214,6 +215,16 @@ nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run) {
   }
   j["trajectory"] = tj;
   return j;
+}
+
+std::string runConfigYaml(const std::string& command, const Scenario& scenario, const PlanRun& run) {
+  std::ostringstream config;
+  config << "# tgnav " << command << " --planner " << planner::toString(run.planner);
+  if (run.planner == planner::PlannerKind::kRrtStar) config << " --samples " << run.rrt_samples;
+  config << " --seed " << run.seed;
+  if (scenario.planner.oracle_class >= 0) config << " --class " << scenario.planner.oracle_class;
+  config << "\n" << resolvedScenarioYaml(scenario);
+  return config.str();
 }
 
 }  // namespace tgnav::harness

@@ -45,6 +45,9 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
                    std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class");
 
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
+// A run's config.yaml: "# tgnav COMMAND --planner P [--samples N] --seed S [--class K]", then the
+// resolved settings it ran with (resolvedScenarioYaml).
+std::string runConfigYaml(const std::string& command, const Scenario& scenario, const PlanRun& run);
 // The generated trajectory sampled at the configured rate, as the controller takes it (and
 // `tgnav fly --trajectory` reads it back from trajectory.csv). Requires a trajectory.
 control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz);

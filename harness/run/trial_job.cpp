@@ -91,18 +91,8 @@ std::string voCsv(const TrialResult& r) {
   return out.str();
 }
 
-std::string configYaml(const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
-  std::ostringstream config;
-  config << "# tgnav trial --planner " << planner::toString(options.planner);
-  if (options.planner == planner::PlannerKind::kRrtStar) config << " --samples " << r.plan.rrt_samples;
-  config << " --seed " << options.seed;
-  if (scenario.planner.oracle_class >= 0) config << " --class " << scenario.planner.oracle_class;
-  config << "\n" << resolvedScenarioYaml(scenario);
-  return config.str();
-}
-
-void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
-  writeFileAtomic(d / "config.yaml", configYaml(scenario, options, r));
+void writeData(const fs::path& d, const Scenario& scenario, const TrialResult& r) {
+  writeFileAtomic(d / "config.yaml", runConfigYaml("trial", scenario, r.plan));
   writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");
   if (r.setpoints) writeFileAtomic(d / "trajectory.csv", trajectoryCsv(*r.setpoints));
   writeFileAtomic(d / "gt.tum", vo::toTum(cameraPoses(r.flight, r.X_BC)));
@@ -161,7 +151,7 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   timing.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   const fs::path& d = staged.staging();
-  writeData(d, scenario, options, r);
+  writeData(d, scenario, r);
   writeMapLayer(d, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   TrialJobResult result;
   if (r.status == TrialStatus::kInterrupted) {

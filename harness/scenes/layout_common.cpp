@@ -81,6 +81,15 @@ TextureLevel drawLevel(SceneRng& rng) {
   return TextureLevel::kPlain;
 }
 
+void drawRoomBounds(Layout& layout, SceneRng& rng, double w_lo, double w_hi, double h_lo, double h_hi) {
+  const double w = std::round(rng.uniform(w_lo, w_hi) * 10.0) / 10.0;
+  const double h = std::round(rng.uniform(h_lo, h_hi) * 10.0) / 10.0;
+  layout.xmin = round2(-0.5 * w);
+  layout.xmax = round2(0.5 * w);
+  layout.ymin = round2(-0.5 * h);
+  layout.ymax = round2(0.5 * h);
+}
+
 void addOuterWalls(Layout& layout, SceneRng& rng) {
   const double t = kWallThicknessM;
   addWall(layout, "s", true, layout.xmin - t, layout.xmax + t, round2(layout.ymin - 0.5 * t), rng);

@@ -15,18 +15,12 @@ constexpr int kMaxLayouts = 2000;
 constexpr double kMinSegmentM = 1.2;
 constexpr double kEndOffsetM = 1.1;  // start and goal from the west and east walls
 
-double round1(double v) { return std::round(v * 10.0) / 10.0; }
-
 Layout emptyRoom(SceneKind kind, std::uint64_t seed, SceneRng& rng, double w_lo, double w_hi, double h_lo,
                  double h_hi) {
   Layout layout;
   layout.kind = kind;
   layout.seed = seed;
-  const double w = round1(rng.uniform(w_lo, w_hi)), h = round1(rng.uniform(h_lo, h_hi));
-  layout.xmin = round2(-0.5 * w);
-  layout.xmax = round2(0.5 * w);
-  layout.ymin = round2(-0.5 * h);
-  layout.ymax = round2(0.5 * h);
+  drawRoomBounds(layout, rng, w_lo, w_hi, h_lo, h_hi);
   layout.light = drawLighting(rng);
   addOuterWalls(layout, rng);
   return layout;

@@ -40,8 +40,6 @@ constexpr int kViewRays = 41;  // across one view
 constexpr int kYaws = 72;      // the yaws a view is looked for at
 constexpr double kStepM = 0.1;
 
-double round1(double v) { return std::round(v * 10.0) / 10.0; }
-
 bool texturedLevel(TextureLevel level) { return level == TextureLevel::kRich || level == TextureLevel::kMedium; }
 
 // Points every kStepM along the polyline.
@@ -216,11 +214,8 @@ Layout detourLayout(std::uint64_t seed) {
   Layout layout;
   layout.kind = SceneKind::kDetour;
   layout.seed = seed;
-  const double w = round1(rng.uniform(13.0, 17.0)), h = round1(rng.uniform(9.0, 12.0));
-  layout.xmin = round2(-0.5 * w);
-  layout.xmax = round2(0.5 * w);
-  layout.ymin = round2(-0.5 * h);
-  layout.ymax = round2(0.5 * h);
+  drawRoomBounds(layout, rng, 13.0, 17.0, 9.0, 12.0);
+  const double w = layout.xmax - layout.xmin;
   layout.light = drawLighting(rng);
   for (layout.attempts = 1; layout.attempts <= kMaxLayouts; ++layout.attempts) {
     layout.blocks.clear();

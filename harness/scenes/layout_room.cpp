@@ -13,8 +13,6 @@ constexpr int kPlacementTries = 40;
 constexpr int kMaxLayouts = 2000;
 constexpr double kObstacleToEndsM = 1.3;  // an obstacle's distance to start and goal
 
-double round1(double v) { return std::round(v * 10.0) / 10.0; }
-
 double drawHeight(SceneRng& rng) { return rng.chance(0.5) ? kRoomHeightM : rng.uniform(1.8, 2.6); }
 
 void addCylinder(Layout& layout, int obstacle, double cx, double cy, double r, double height_m, SceneRng& rng) {
@@ -102,11 +100,7 @@ Layout roomLayout(std::uint64_t seed) {
   Layout layout;
   layout.kind = SceneKind::kRoom;
   layout.seed = seed;
-  const double w = round1(rng.uniform(8.0, 16.0)), h = round1(rng.uniform(6.0, 12.0));
-  layout.xmin = round2(-0.5 * w);
-  layout.xmax = round2(0.5 * w);
-  layout.ymin = round2(-0.5 * h);
-  layout.ymax = round2(0.5 * h);
+  drawRoomBounds(layout, rng, 8.0, 16.0, 6.0, 12.0);
   layout.start = {round2(layout.xmin + 1.3), round2(rng.uniform(layout.ymin + 1.5, layout.ymax - 1.5)), 0.0};
   layout.goal = {round2(layout.xmax - 1.3), round2(rng.uniform(layout.ymin + 1.5, layout.ymax - 1.5)), 0.0};
   layout.light = drawLighting(rng);

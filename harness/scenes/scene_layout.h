@@ -85,6 +85,9 @@ std::string validateLayout(const Layout& layout);
 
 // --- Building blocks of the layouts (harness/scenes/layout_common.cpp) ---
 TextureLevel drawLevel(SceneRng& rng);
+// A room of free space w x h centred on the origin, w in [w_lo, w_hi] and h in [h_lo, h_hi]
+// drawn in that order, each to decimetres; sets the layout's bounds.
+void drawRoomBounds(Layout& layout, SceneRng& rng, double w_lo, double w_hi, double h_lo, double h_hi);
 // Outer wall panels (at most kMaxPanelM long) around the free space, each with a drawn level.
 void addOuterWalls(Layout& layout, SceneRng& rng);
 // A new obstacle; returns its index.
