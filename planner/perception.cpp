@@ -19,11 +19,29 @@ void InformationConfig::validate() const {
           "must be in [0, 1]");
   require(min_detections >= 0.0 && std::isfinite(min_detections), "min_detections", min_detections,
           "must be finite and >= 0");
+  require(min_track_probability > 0.0 && min_track_probability < 1.0, "min_track_probability", min_track_probability,
+          "must be in (0, 1)");
 }
 
 double ViewSupport::coverage() const {
   return static_cast<double>(__builtin_popcountll(cells)) / (kImageCols * kImageRows);
 }
+
+double ViewSupport::columnSpan() const {
+  std::uint64_t rows_or = 0;  // bit col: some row holds a cell in that column
+  for (int r = 0; r < kImageRows; ++r) rows_or |= (cells >> (r * kImageCols)) & ((std::uint64_t{1} << kImageCols) - 1);
+  return static_cast<double>(__builtin_popcountll(rows_or)) / kImageCols;
+}
+
+double ViewSupport::rowSpan() const {
+  int rows = 0;
+  for (int r = 0; r < kImageRows; ++r) {
+    rows += ((cells >> (r * kImageCols)) & ((std::uint64_t{1} << kImageCols) - 1)) != 0;
+  }
+  return static_cast<double>(rows) / kImageRows;
+}
+
+double ViewSupport::meanRangeM() const { return detections > 0.0 ? range_detections / detections : 0.0; }
 
 ImageCells::ImageCells(double yaw_rad, const VisibilityConfig& visibility)
     : cos_yaw_(std::cos(yaw_rad)),
@@ -56,12 +74,20 @@ bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, con
 }
 
 double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config) {
+  if (config.model) {
+    const bool blind = config.model->probability(support) < config.min_track_probability;
+    return logDetInformation(blind ? Matrix6d::Zero() : info, config.epsilon);
+  }
   const bool blind = support.landmarks < config.min_landmarks || support.detections < config.min_detections ||
                      (config.min_image_coverage > 0.0 && support.coverage() < config.min_image_coverage);
   return blind ? logDetInformation(Matrix6d::Zero(), config.epsilon) : logDetInformation(info, config.epsilon);
 }
 
 double gateShortfall(const ViewSupport& support, const InformationConfig& config) {
+  if (config.model) {
+    const double p = config.model->probability(support);
+    return p < config.min_track_probability ? 1.0 - p / config.min_track_probability : 0.0;
+  }
   double least = 1.0;  // the smallest share of a gate's threshold reached
   if (support.landmarks < config.min_landmarks) least = std::min(least, support.landmarks / config.min_landmarks);
   if (support.detections < config.min_detections) {
@@ -130,7 +156,7 @@ Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::
   for (const WeightedPoint& pt : points) {
     if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
-      view.add(pt, cell(p_W, pt.p_W));
+      view.add(pt, (pt.p_W - p_W).norm(), cell(p_W, pt.p_W));
     }
   }
   if (support != nullptr) *support = view;

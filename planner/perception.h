@@ -11,10 +11,13 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "planner/feature_map.h"
 #include "planner/fisher.h"
+#include "planner/track_model.h"
 #include "planner/voxel_map.h"
 
 namespace tgnav::planner {
@@ -47,6 +50,15 @@ struct InformationConfig {
   // (README: the perception model). The information itself stays the paper's: every landmark
   // in view adds its bearing information (c_p keeps the scale of Table I's c_p,thr).
   double min_detections = 50.0;
+  // A learned perception model (track_model.h) in place of the three gates above: a pose scores
+  // blind where the model gives the VO less than min_track_probability of tracking it. The file
+  // (JSON, scripts/fit_track_model.py) is read by the harness, which sets `model`; "none": the gates.
+  std::string track_model = "none";
+  double min_track_probability = 0.5;
+  std::shared_ptr<const TrackModel> model;  // read from track_model; not a key
+
+  // True when a pose's score needs the image cells its landmarks fall in (the coverage gate or a model).
+  bool usesImageCells() const { return min_image_coverage > 0.0 || model != nullptr; }
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -57,6 +69,8 @@ struct InformationConfig {
     a("min_landmarks", min_landmarks);
     a("min_image_coverage", min_image_coverage);
     a("min_detections", min_detections);
+    a("track_model", track_model);
+    a("min_track_probability", min_track_probability);
   }
 
   void validate() const;
@@ -77,23 +91,33 @@ bool withinIncidence(const Eigen::Vector3d& p_W, const WeightedPoint& point, con
 constexpr int kImageCols = 8;
 constexpr int kImageRows = 6;
 
+// The range within which a landmark's detections also count as near ones (ViewSupport).
+constexpr double kNearRangeM = 3.0;
+
 // What backs a pose's information: the landmarks that count and the image cells they fall in.
 struct ViewSupport {
-  double landmarks = 0.0;   // their summed weight
-  double detections = 0.0;  // their summed detections
-  std::uint64_t cells = 0;  // bit row * kImageCols + col: a landmark falls in that cell
-  void count(const WeightedPoint& point) {
+  double landmarks = 0.0;         // their summed weight
+  double detections = 0.0;        // their summed detections
+  double near_detections = 0.0;   // the detections of those within kNearRangeM of the camera
+  double range_detections = 0.0;  // sum of detections x range, m
+  std::uint64_t cells = 0;        // bit row * kImageCols + col: a landmark falls in that cell
+  void count(const WeightedPoint& point, double range_m) {
     landmarks += point.weight;
     detections += point.detections;
+    range_detections += point.detections * range_m;
+    if (range_m < kNearRangeM) near_detections += point.detections;
   }
   void cover(int cell) {
     if (cell >= 0) cells |= std::uint64_t{1} << cell;
   }
-  void add(const WeightedPoint& point, int cell) {
-    count(point);
+  void add(const WeightedPoint& point, double range_m, int cell) {
+    count(point, range_m);
     cover(cell);
   }
-  double coverage() const;  // share of the kImageCols x kImageRows cells marked
+  double coverage() const;    // share of the kImageCols x kImageRows cells marked
+  double columnSpan() const;  // share of the kImageCols columns with a marked cell
+  double rowSpan() const;     // share of the kImageRows rows with a marked cell
+  double meanRangeM() const;  // detection-weighted mean range; 0 without detections
 };
 
 // The cell of a level pinhole camera's image at p_W looking along yaw_rad that l_W projects into
@@ -116,12 +140,15 @@ class ImageCells {
 
 // The score of a pose from its information and what backs it: log det (I + eps Id), or the blind
 // score 6 ln eps when fewer than config.min_landmarks count, they promise fewer than
-// config.min_detections detections or they cover less of the image than config.min_image_coverage.
+// config.min_detections detections or they cover less of the image than config.min_image_coverage;
+// with a model (config.model), when the model's probability is below config.min_track_probability
+// (the three gates are then not used).
 double scoreInformation(const Matrix6d& info, const ViewSupport& support, const InformationConfig& config);
 
 // How far a pose falls short of its gates: 0 when it passes every gate of scoreInformation() (or
 // none is set), else 1 minus the smallest of landmarks / min_landmarks, detections /
-// min_detections and coverage / min_image_coverage over the gates it fails, in (0, 1].
+// min_detections and coverage / min_image_coverage over the gates it fails, in (0, 1]; with a
+// model, 1 - p / min_track_probability where p falls below it.
 double gateShortfall(const ViewSupport& support, const InformationConfig& config);
 
 // The score a search ranks a pose by (ours): scoreInformation(), lowered by gateShortfall() times

@@ -164,7 +164,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   std::vector<std::vector<WeightedPoint>> layer_seen(static_cast<std::size_t>(layers));
   // What the camera sees around a layer (V of its path point, any yaw): the image coverage of
   // InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
-  const bool gate = information.min_image_coverage > 0.0;
+  const bool gate = information.usesImageCells();
   static const std::vector<WeightedPoint> kNone;
   auto segmentAt = [&](double s) {
     int seg = 0;
@@ -256,11 +256,15 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       for (const WeightedPoint& pt : points) {
         Matrix6d contribution = Matrix6d::Zero();
         bool computed = false;
+        double range = 0.0;
         forYawsHolding(pt, [&](std::size_t idx) {
-          if (!computed) addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
+          if (!computed) {
+            addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
+            range = (pt.p_W - p).norm();
+          }
           computed = true;
           info[idx] += contribution;
-          support[idx].count(pt);
+          support[idx].count(pt, range);
         });
       }
       for (const WeightedPoint& pt : seen) {

@@ -220,13 +220,13 @@ class CovisibilityScorer {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
         const WeightedPoint point{l.mean_W, static_cast<double>(l.ids.size()), l.normal_W, l.detections};
         addCentredInformation(p2, point.p_W, point.weight, config_.information.bearing_noise_rad, &info);
-        support.count(point);
+        support.count(point, (point.p_W - p2).norm());
         ++i;
         ++j;
       }
     }
     // The image coverage is the camera's at s2: all of its view, not only the common part.
-    if (config_.information.min_image_coverage > 0.0) {
+    if (config_.information.usesImageCells()) {
       for (int slot : b.slots) {
         support.cover(
             imageCell(p2, yaw2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W, config_.visibility));

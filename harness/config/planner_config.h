@@ -2,6 +2,7 @@
 // configs/planner.yaml <-> the planners' Config structs (strict keys; defaults are Table I).
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "harness/config/yaml_util.h"
@@ -46,7 +47,7 @@ struct PlannerSettings {
 
 // A planner.yaml read over `base`, then validated (InputError naming the file).
 inline PlannerSettings loadPlannerSettings(const std::filesystem::path& yaml, PlannerSettings base = {}) {
-  return loadConfigFile(yaml, base);
+  return loadConfigFile(yaml, std::move(base));
 }
 
 }  // namespace tgnav::harness

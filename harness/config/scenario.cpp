@@ -6,6 +6,7 @@
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
 #include "harness/config/config_io.h"
+#include "harness/config/track_model_file.h"
 #include "harness/config/vehicle_config.h"
 
 namespace tgnav::harness {
@@ -127,6 +128,28 @@ class SectionReader {
   const YamlDoc* overrides_;
 };
 
+// Reads the learned perception model that planner.information.track_model names (relative to the
+// current directory when --set gives it, else to the scenario file) into the planners' settings,
+// and records its absolute path there (config.yaml); no model when the key is "none".
+void readTrackModel(const YamlDoc& doc, const YamlDoc* overrides, PlannerSettings* planner) {
+  planner::InformationConfig& info = planner->perception.information;
+  info.model.reset();
+  if (info.track_model != "none") {
+    const bool overridden = overrides && overrides->root()["planner"] && overrides->root()["planner"]["information"] &&
+                            overrides->root()["planner"]["information"]["track_model"];
+    const fs::path base = overridden ? fs::path() : doc.file().parent_path();
+    const fs::path file = fs::absolute(base / info.track_model).lexically_normal();
+    if (!isRegularFile(file)) {
+      throw InputError((overridden ? std::string("--set") : doc.file().string()) +
+                       ": key 'planner.information.track_model' has value '" + info.track_model + "': file " +
+                       file.string() + " not found");
+    }
+    info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
+    info.track_model = file.string();
+  }
+  planner->shareFromPerception();
+}
+
 YAML::Node poseYaml(const planner::Pose4& pose) {
   const double v[4] = {pose.p_WB.x(), pose.p_WB.y(), pose.p_WB.z(), pose.yaw_rad};
   return exactSequence(v, 4);
@@ -168,6 +191,7 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
 
   SectionReader sections(doc, overrides);
   s.visitSections(sections);
+  readTrackModel(doc, overrides, &s.planner);
   return s;
 }
 

@@ -25,6 +25,11 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   out.landmarks = static_cast<int>(support.landmarks);
   out.detections = support.detections;
   out.coverage = support.coverage();
+  out.near_detections = support.near_detections;
+  out.mean_range_m = support.meanRangeM();
+  out.column_span = support.columnSpan();
+  out.row_span = support.rowSpan();
+  if (information.model) out.track_probability = information.model->probability(support);
   return out;
 }
 

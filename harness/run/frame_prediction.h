@@ -15,6 +15,12 @@ struct FramePrediction {
   int landmarks = 0;        // map landmarks that count (in the field of view, range, line of sight and incidence limit)
   double detections = 0.0;  // the detections they promise (planner::ViewSupport::detections)
   double coverage = 0.0;    // share of the image's cells that hold one of them (planner::ViewSupport)
+  // The learned model's inputs besides those (planner::trackFeatureValue) and its output.
+  double near_detections = 0.0;     // detections of landmarks within planner::kNearRangeM
+  double mean_range_m = 0.0;        // detection-weighted mean range
+  double column_span = 0.0;         // share of the image's columns holding a landmark
+  double row_span = 0.0;            // share of its rows
+  double track_probability = -1.0;  // the model's probability that the VO tracks the frame; -1: no model
 };
 
 // The model at the true camera pose X_WC (optical frame: z forward): position and the yaw of the

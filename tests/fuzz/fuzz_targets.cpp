@@ -12,6 +12,7 @@
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
+#include "harness/config/track_model_file.h"
 #include "harness/config/vehicle_config.h"
 #include "harness/config/yaml_util.h"
 #include "harness/experiments/sweep.h"
@@ -226,6 +227,13 @@ const std::vector<Entry>& entries() {
            }
          }
        }},
+      {{"track_model", "a learned perception model's JSON (planner.information.track_model)"},
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path file = scratch().fresh() / "model.json";
+         write(file, t);
+         harness::loadTrackModel(file);
+       }},
       {{"sweep", "sections: sweep YAML, scenario YAML (../scenarios/fuzz.yaml), scene YAML"},
        harnessParser,
        [](const std::string& t) {
@@ -393,6 +401,11 @@ std::vector<std::string> repositorySeeds(const std::string& name, const fs::path
           std::regex_replace(readText(scenes[i % scenes.size()]), std::regex(R"(\.\./quadrotor\.xml)"), "vehicle.xml");
       seeds.push_back(join({d, scene}));
     }
+  } else if (name == "track_model") {
+    for (const auto& e : fs::directory_iterator(configs)) {
+      if (e.path().extension() == ".json") seeds.push_back(readText(e.path()));
+    }
+    std::sort(seeds.begin(), seeds.end());
   } else if (name == "trajectory_csv") {
     for (const auto& e : fs::directory_iterator(configs / "trajectories")) {
       if (e.path().extension() == ".csv") seeds.push_back(readText(e.path()));

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -144,6 +145,72 @@ TEST(GateShortfall, RanksGatedPosesByTheGateTheyMissMostAndLeavesPassingOnesAlon
   more.detections = 60.0;
   EXPECT_GT(rankedScore(blind, more, info), rankedScore(blind, some, info));
   EXPECT_LT(rankedScore(blind, more, info), blind);
+}
+
+// The support's spans and ranges: which columns and rows hold a cell, the detections near the
+// camera and their mean range.
+TEST(ViewSupport, SpansAndRangesOfAView) {
+  ViewSupport s;
+  EXPECT_DOUBLE_EQ(s.columnSpan(), 0.0);
+  EXPECT_DOUBLE_EQ(s.rowSpan(), 0.0);
+  EXPECT_DOUBLE_EQ(s.meanRangeM(), 0.0);
+  s.cover(0);                                // row 0, column 0
+  s.cover(kImageCols + 0);                   // row 1, column 0
+  s.cover(3 * kImageCols + kImageCols - 1);  // row 3, the last column
+  EXPECT_DOUBLE_EQ(s.columnSpan(), 2.0 / kImageCols);
+  EXPECT_DOUBLE_EQ(s.rowSpan(), 3.0 / kImageRows);
+  WeightedPoint near_point;
+  near_point.detections = 3.0;
+  WeightedPoint far_point;
+  far_point.detections = 1.0;
+  s.count(near_point, 2.0);
+  s.count(far_point, 8.0);
+  EXPECT_DOUBLE_EQ(s.detections, 4.0);
+  EXPECT_DOUBLE_EQ(s.near_detections, 3.0);  // within kNearRangeM = 3 m
+  EXPECT_DOUBLE_EQ(s.meanRangeM(), (3.0 * 2.0 + 8.0) / 4.0);
+}
+
+// A learned model in place of the gates: the probability is the logistic of the standardised
+// features; a pose below min_track_probability scores blind however the gates would rate it,
+// and ranks by how far it falls short.
+TEST(TrackModel, ReplacesTheGatesWithAProbability) {
+  TrackModel model;
+  model.terms.push_back({TrackFeature::kLogDetections, std::log1p(50.0), 0.5, 2.0});
+  model.terms.push_back({TrackFeature::kCoverage, 0.2, 0.1, 1.0});
+  model.intercept = 0.0;
+  ViewSupport s;
+  s.detections = 50.0;
+  for (int cell = 0; cell < 10; ++cell) s.cover(cell);  // 10 of 48 cells: coverage 0.208
+  const double z = 2.0 * 0.0 + 1.0 * (10.0 / 48.0 - 0.2) / 0.1;
+  EXPECT_NEAR(model.probability(s), 1.0 / (1.0 + std::exp(-z)), 1e-12);
+  ViewSupport poor = s;
+  poor.detections = 5.0;
+  EXPECT_LT(model.probability(poor), 0.05);
+
+  InformationConfig info;
+  info.min_detections = 1000.0;  // the gates would blind both; with a model they are not used
+  info.model = std::make_shared<const TrackModel>(model);
+  info.min_track_probability = 0.5;
+  Matrix6d fisher = Matrix6d::Identity() * 100.0;
+  const double blind = 6.0 * std::log(info.epsilon);
+  EXPECT_GT(scoreInformation(fisher, s, info), blind);
+  EXPECT_DOUBLE_EQ(gateShortfall(s, info), 0.0);
+  EXPECT_DOUBLE_EQ(scoreInformation(fisher, poor, info), blind);
+  EXPECT_NEAR(gateShortfall(poor, info), 1.0 - model.probability(poor) / 0.5, 1e-12);
+  ViewSupport poorer = poor;
+  poorer.detections = 1.0;
+  EXPECT_LT(rankedScore(blind, poorer, info), rankedScore(blind, poor, info));
+  EXPECT_TRUE(info.usesImageCells());
+}
+
+TEST(TrackModel, FeatureNamesRoundTrip) {
+  for (const std::string& name : trackFeatureNames()) {
+    TrackFeature f{};
+    ASSERT_TRUE(parseTrackFeature(name, &f)) << name;
+    EXPECT_EQ(trackFeatureNames()[static_cast<std::size_t>(f)], name);
+  }
+  TrackFeature f{};
+  EXPECT_FALSE(parseTrackFeature("detections", &f));
 }
 
 TEST(Incidence, GrazingViewsDoNotCountWhereTheNormalIsKnown) {

@@ -1,0 +1,96 @@
+#include "harness/config/track_model_file.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "harness/base/errors.h"
+#include "harness/base/files.h"
+
+namespace tgnav::harness {
+
+namespace {
+
+using Json = nlohmann::json;
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {
+  throw InputError(file.string() + ": " + what);
+}
+
+const Json& member(const std::filesystem::path& file, const Json& doc, const char* key) {
+  const auto it = doc.find(key);
+  if (it == doc.end()) fail(file, std::string("key '") + key + "' is missing");
+  return *it;
+}
+
+double number(const std::filesystem::path& file, const Json& value, const std::string& key) {
+  if (!value.is_number()) fail(file, "key '" + key + "' has value '" + value.dump() + "', expected a number");
+  const double v = value.get<double>();
+  if (!std::isfinite(v)) fail(file, "key '" + key + "' has value '" + value.dump() + "', expected a finite number");
+  return v;
+}
+
+std::vector<double> numbers(const std::filesystem::path& file, const Json& doc, const char* key, std::size_t n) {
+  const Json& array = member(file, doc, key);
+  if (!array.is_array() || array.size() != n) {
+    fail(file, std::string("key '") + key + "' has value '" + array.dump().substr(0, 80) + "', expected an array of " +
+                   std::to_string(n) + " numbers (one per feature)");
+  }
+  std::vector<double> out;
+  for (std::size_t i = 0; i < n; ++i)
+    out.push_back(number(file, array[i], std::string(key) + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+}  // namespace
+
+planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
+  const std::string text = readTextFile(file);  // InputError naming the file when it cannot be read
+  Json doc;
+  try {
+    doc = Json::parse(text);
+  } catch (const Json::exception& e) {  // parse_error, or out_of_range for a number like 1e999
+    fail(file, std::string("not JSON (") + e.what() + ")");
+  }
+  if (!doc.is_object()) fail(file, "expected a JSON object, found '" + doc.dump().substr(0, 40) + "'");
+  const Json& format = member(file, doc, "format");
+  if (format != "tgnav-track-model") {
+    fail(file, "key 'format' has value '" + format.dump() + "', expected \"tgnav-track-model\"");
+  }
+  const Json& version = member(file, doc, "version");
+  if (version != 1)
+    fail(file, "key 'version' has value '" + version.dump() + "', expected 1 (this build reads version 1)");
+  const Json& kind = member(file, doc, "kind");
+  if (kind != "logistic") fail(file, "key 'kind' has value '" + kind.dump() + "', expected \"logistic\"");
+  const Json& features = member(file, doc, "features");
+  if (!features.is_array() || features.empty()) {
+    fail(file, "key 'features' has value '" + features.dump().substr(0, 80) + "', expected a non-empty array of names");
+  }
+  planner::TrackModel model;
+  model.source = file.string();
+  const std::size_t n = features.size();
+  const std::vector<double> mean = numbers(file, doc, "mean", n);
+  const std::vector<double> scale = numbers(file, doc, "scale", n);
+  const std::vector<double> weights = numbers(file, doc, "weights", n);
+  for (std::size_t i = 0; i < n; ++i) {
+    planner::TrackModel::Term term;
+    const std::string key = "features[" + std::to_string(i) + "]";
+    if (!features[i].is_string() || !planner::parseTrackFeature(features[i].get<std::string>(), &term.feature)) {
+      std::string known;
+      for (const std::string& name : planner::trackFeatureNames()) known += (known.empty() ? "" : ", ") + name;
+      fail(file, "key '" + key + "' has value '" + features[i].dump() + "', expected one of " + known);
+    }
+    if (!(scale[i] > 0.0)) {
+      fail(file, "key 'scale[" + std::to_string(i) + "]' has value '" + std::to_string(scale[i]) + "', expected > 0");
+    }
+    term.mean = mean[i];
+    term.scale = scale[i];
+    term.weight = weights[i];
+    model.terms.push_back(term);
+  }
+  model.intercept = number(file, member(file, doc, "intercept"), "intercept");
+  return model;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,17 @@
+#pragma once
+// The learned perception model's file (planner/track_model.h), written by
+// scripts/fit_track_model.py:
+//   {"format": "tgnav-track-model", "version": 1, "kind": "logistic",
+//    "features": [NAME, ...], "mean": [...], "scale": [...], "weights": [...], "intercept": B, ...}
+// Other keys (what it was fitted on, its scores) are the script's record and are not read. Every
+// feature name must be one of planner::trackFeatureNames(); the arrays match it in length; every
+// number is finite and every scale > 0. Anything else is an InputError naming the file and key.
+#include <filesystem>
+
+#include "planner/track_model.h"
+
+namespace tgnav::harness {
+
+planner::TrackModel loadTrackModel(const std::filesystem::path& file);
+
+}  // namespace tgnav::harness

@@ -1,0 +1,52 @@
+#include "planner/track_model.h"
+
+#include <cmath>
+
+#include "planner/perception.h"
+
+namespace tgnav::planner {
+
+const std::vector<std::string>& trackFeatureNames() {
+  static const std::vector<std::string> names = {"log_detections", "log_landmarks",       "coverage",    "column_span",
+                                                 "row_span",       "log_near_detections", "mean_range_m"};
+  return names;
+}
+
+bool parseTrackFeature(const std::string& name, TrackFeature* feature) {
+  const std::vector<std::string>& names = trackFeatureNames();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) {
+      *feature = static_cast<TrackFeature>(i);
+      return true;
+    }
+  }
+  return false;
+}
+
+double trackFeatureValue(TrackFeature feature, const ViewSupport& support) {
+  switch (feature) {
+    case TrackFeature::kLogDetections:
+      return std::log1p(support.detections);
+    case TrackFeature::kLogLandmarks:
+      return std::log1p(support.landmarks);
+    case TrackFeature::kCoverage:
+      return support.coverage();
+    case TrackFeature::kColumnSpan:
+      return support.columnSpan();
+    case TrackFeature::kRowSpan:
+      return support.rowSpan();
+    case TrackFeature::kLogNearDetections:
+      return std::log1p(support.near_detections);
+    case TrackFeature::kMeanRange:
+      return support.meanRangeM();
+  }
+  return 0.0;
+}
+
+double TrackModel::probability(const ViewSupport& support) const {
+  double z = intercept;
+  for (const Term& t : terms) z += t.weight * (trackFeatureValue(t.feature, support) - t.mean) / t.scale;
+  return 1.0 / (1.0 + std::exp(-z));
+}
+
+}  // namespace tgnav::planner

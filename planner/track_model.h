@@ -1,0 +1,50 @@
+#pragma once
+// A perception model learned from the closed loop (issue 38; the paper's future work: "reducing
+// the need of tuning parameters via data-driven methods"): the probability that the VO tracks a
+// frame (at least vo.min_inliers PnP inliers) from what the planner computes for a pose before
+// flying (ViewSupport: the landmarks in view, the detections they promise, how much of the image
+// they cover, how near they are). A logistic model over standardised features,
+//   p = 1 / (1 + exp(-(b + sum_i w_i (f_i - mean_i) / scale_i))),
+// fitted offline by scripts/fit_track_model.py on oracle trials of calibration scenes and read
+// from its JSON file by the harness (harness/config/track_model_file.h). With a model, a pose
+// scores blind below InformationConfig::min_track_probability (perception.h) in place of the
+// hand-set gates: c_p,thr becomes a probability with a meaning.
+#include <string>
+#include <vector>
+
+namespace tgnav::planner {
+
+struct ViewSupport;
+
+// What a model may use; the names are the JSON file's and vo.csv's (predicted_<name>).
+enum class TrackFeature {
+  kLogDetections,      // log(1 + detections promised)
+  kLogLandmarks,       // log(1 + landmarks that count)
+  kCoverage,           // share of the image's cells holding a landmark
+  kColumnSpan,         // share of the image's columns holding a landmark
+  kRowSpan,            // share of its rows
+  kLogNearDetections,  // log(1 + detections of landmarks within kNearRangeM)
+  kMeanRange,          // detection-weighted mean range of the landmarks, m (0 when none)
+};
+
+const std::vector<std::string>& trackFeatureNames();  // in TrackFeature's order
+// The feature called `name`, or false when there is none of that name.
+bool parseTrackFeature(const std::string& name, TrackFeature* feature);
+double trackFeatureValue(TrackFeature feature, const ViewSupport& support);
+
+struct TrackModel {
+  struct Term {
+    TrackFeature feature = TrackFeature::kLogDetections;
+    double mean = 0.0;
+    double scale = 1.0;  // > 0
+    double weight = 0.0;
+  };
+  std::vector<Term> terms;
+  double intercept = 0.0;
+  std::string source;  // the file it came from (reports, errors)
+
+  // The probability that the VO tracks a frame whose view has `support`.
+  double probability(const ViewSupport& support) const;
+};
+
+}  // namespace tgnav::planner

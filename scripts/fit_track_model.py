@@ -1,0 +1,359 @@
+#!/usr/bin/python3
+"""The learned perception model (issue 38): fit it on trials, evaluate it on others.
+
+A trial's vo.csv holds, per camera frame, what the VO did (status, inliers) beside the planner's
+view features at the true camera pose (predicted_detections, predicted_landmarks,
+predicted_coverage, predicted_near_detections, predicted_mean_range_m, predicted_column_span,
+predicted_row_span: planner/perception.h's ViewSupport over every landmark of the map in view).
+The model is a logistic regression of "the VO tracks this frame" on those features, as
+planner/track_model.h evaluates it; its JSON file is what `planner.information.track_model` reads.
+
+Frames used: airborne (true z above --min-z), not an initialisation (a frame the VO started or
+restarted on: not lost, no matches). A frame the VO could not restart on is a lost one. Label: tracked with at least min_inliers
+PnP inliers (the trial's config.yaml vo.min_inliers).
+
+  fit_track_model.py fit SWEEP_DIR [SWEEP_DIR...] --out MODEL.json
+      fits on every trial of the sweeps; reports leave-one-scene-out ROC AUC (each scene's frames
+      scored by a model fitted on the other scenes) beside the training AUC, and the AUC a model
+      with the motion (speed, yaw rate from gt.tum) would reach, which the planner does not use.
+  fit_track_model.py evaluate SWEEP_DIR [...] --model MODEL.json --out DIR
+      scores another set of trials (scenes the model never saw): per-frame ROC AUC, a reliability
+      diagram (DIR/reliability.png, DIR/reliability.csv), and, for the oracle trials
+      (planner.oracle_class set), "class flyable" as predicted (every frame of the flown class at
+      or above --threshold) against what the VO did (tracked to the goal). Writes DIR/evaluation.json.
+Exit status 2 with one line naming the file on bad input.
+"""
+import argparse
+import glob
+import hashlib
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+FEATURES = ["log_detections", "log_landmarks", "coverage", "column_span", "row_span", "log_near_detections",
+            "mean_range_m"]
+COLUMNS = {"log_detections": "predicted_detections", "log_landmarks": "predicted_landmarks",
+           "coverage": "predicted_coverage", "column_span": "predicted_column_span",
+           "row_span": "predicted_row_span", "log_near_detections": "predicted_near_detections",
+           "mean_range_m": "predicted_mean_range_m"}
+LOGGED = {"log_detections", "log_landmarks", "log_near_detections"}
+
+
+class InputError(Exception):
+    pass
+
+
+def config_value(config_path, section, key, default):
+    """A scalar of a trial's resolved config.yaml (`section:` then `  key: value`)."""
+    try:
+        import yaml
+        with open(config_path) as f:
+            doc = yaml.safe_load(f)
+        node = doc
+        for part in section.split("."):
+            node = node[part]
+        return node.get(key, default)
+    except (OSError, KeyError, TypeError, AttributeError):
+        return default
+
+
+def read_gt_yaw(path):
+    """(t, yaw of the optical axis) from a gt.tum of camera poses (z forward)."""
+    try:
+        data = np.loadtxt(path, ndmin=2)
+    except (OSError, ValueError):
+        return None
+    if data.size == 0 or data.shape[1] != 8:
+        return None
+    qx, qy, qz, qw = data[:, 4], data[:, 5], data[:, 6], data[:, 7]
+    # third column of the rotation matrix: the optical axis in the world
+    fx = 2 * (qx * qz + qw * qy)
+    fy = 2 * (qy * qz - qw * qx)
+    return data[:, 0], np.unwrap(np.arctan2(fy, fx))
+
+
+def read_trial(folder, min_z):
+    """Per-frame features, labels and motion of one trial folder, or None without a vo.csv."""
+    path = os.path.join(folder, "vo.csv")
+    if not os.path.isfile(path):
+        return None
+    with open(path) as f:
+        header = f.readline().strip().split(",")
+        rows = [line.rstrip("\n").split(",") for line in f if line.strip()]
+    need = ["t", "status", "matches", "inliers", "x_true", "y_true", "z_true"] + [COLUMNS[n] for n in FEATURES]
+    missing = [n for n in need if n not in header]
+    if missing:
+        raise InputError(f"{path}: column '{missing[0]}' is missing (trials from before the model's features were logged)")
+    idx = {n: header.index(n) for n in need}
+    try:
+        t = np.array([float(r[idx["t"]]) for r in rows])
+        status = [r[idx["status"]] for r in rows]
+        matches = np.array([float(r[idx["matches"]]) for r in rows])
+        inliers = np.array([float(r[idx["inliers"]]) for r in rows])
+        pos = np.array([[float(r[idx[c]]) for c in ("x_true", "y_true", "z_true")] for r in rows])
+        raw = {n: np.array([float(r[idx[COLUMNS[n]]]) for r in rows]) for n in FEATURES}
+    except (ValueError, IndexError) as e:
+        raise InputError(f"{path}: a row does not parse ({e})")
+    if len(t) == 0:
+        return None
+    min_inliers = float(config_value(os.path.join(folder, "config.yaml"), "vo", "min_inliers", 30))
+    x = np.column_stack([np.log1p(raw[n]) if n in LOGGED else raw[n] for n in FEATURES])
+    label = np.array([s != "lost" for s in status]) & (inliers >= min_inliers)
+    lost = np.array([s == "lost" for s in status])
+    initialisation = ~lost & (matches == 0)  # the VO (re)started on this frame: nothing was tracked
+    keep = (pos[:, 2] > min_z) & ~initialisation
+    # motion: speed from the true positions, yaw rate from gt.tum
+    speed = np.zeros(len(t))
+    if len(t) > 1:
+        v = np.gradient(pos, t, axis=0)
+        speed = np.linalg.norm(v[:, :2], axis=1)
+    yaw_rate = np.zeros(len(t))
+    gt = read_gt_yaw(os.path.join(folder, "gt.tum"))
+    if gt is not None and len(gt[0]) > 2:
+        rate = np.gradient(gt[1], gt[0])
+        yaw_rate = np.abs(np.interp(t, gt[0], rate))
+    oracle = config_value(os.path.join(folder, "config.yaml"), "planner", "oracle_class", -1)
+    scene = os.path.basename(folder).split("__")[0]
+    return {"folder": folder, "scene": scene, "x": x[keep], "y": label[keep], "motion": np.column_stack(
+        [speed, yaw_rate])[keep], "oracle": int(oracle) if oracle is not None else -1, "t": t[keep],
+        "all_frames": len(t)}
+
+
+def read_sweeps(dirs, min_z):
+    trials = []
+    for d in dirs:
+        if not os.path.isdir(d):
+            raise InputError(f"{d}: not a folder")
+        folders = sorted(glob.glob(os.path.join(d, "trials", "*")))
+        if not folders:
+            raise InputError(f"{d}: no trials/ folders (a sweep's output folder is expected)")
+        for folder in folders:
+            tr = read_trial(folder, min_z)
+            if tr is not None and len(tr["y"]) > 0:
+                trials.append(tr)
+    if not trials:
+        raise InputError(f"{', '.join(dirs)}: no trial has airborne frames")
+    return trials
+
+
+def stack(trials, key):
+    return np.concatenate([tr[key] for tr in trials])
+
+
+def fit_logistic(x, y, c):
+    from sklearn.linear_model import LogisticRegression
+    mean = x.mean(axis=0)
+    scale = x.std(axis=0)
+    scale[scale <= 0] = 1.0
+    model = LogisticRegression(C=c, max_iter=2000)
+    model.fit((x - mean) / scale, y)
+    return mean, scale, model.coef_[0], float(model.intercept_[0])
+
+
+def probability(x, mean, scale, weights, intercept):
+    z = intercept + ((x - mean) / scale) @ weights
+    return 1.0 / (1.0 + np.exp(-z))
+
+
+def auc(y, p):
+    from sklearn.metrics import roc_auc_score
+    return float(roc_auc_score(y, p)) if 0 < y.sum() < len(y) else float("nan")
+
+
+def leave_one_scene_out(trials, c, with_motion=False):
+    scenes = sorted({tr["scene"] for tr in trials})
+    ys, ps = [], []
+    for s in scenes:
+        train = [tr for tr in trials if tr["scene"] != s]
+        test = [tr for tr in trials if tr["scene"] == s]
+        xtr = stack(train, "x")
+        xte = stack(test, "x")
+        if with_motion:
+            xtr = np.column_stack([xtr, stack(train, "motion")])
+            xte = np.column_stack([xte, stack(test, "motion")])
+        ytr = stack(train, "y")
+        if ytr.min() == ytr.max():
+            continue
+        m, sc, w, b = fit_logistic(xtr, ytr, c)
+        ys.append(stack(test, "y"))
+        ps.append(probability(xte, m, sc, w, b))
+    return auc(np.concatenate(ys), np.concatenate(ps))
+
+
+def cmd_fit(args):
+    trials = read_sweeps(args.sweeps, args.min_z)
+    x, y = stack(trials, "x"), stack(trials, "y")
+    if y.min() == y.max():
+        raise InputError(f"{', '.join(args.sweeps)}: every frame has the same label; nothing to fit")
+    mean, scale, weights, intercept = fit_logistic(x, y, args.c)
+    train_auc = auc(y, probability(x, mean, scale, weights, intercept))
+    loso = leave_one_scene_out(trials, args.c)
+    loso_motion = leave_one_scene_out(trials, args.c, with_motion=True)
+    scenes = sorted({tr["scene"] for tr in trials})
+    threshold, accuracy, flights = choose_threshold(trials, mean, scale, weights, intercept)
+    doc = {
+        "format": "tgnav-track-model", "version": 1, "kind": "logistic",
+        "label": "the VO tracks the frame with at least vo.min_inliers PnP inliers",
+        "features": FEATURES, "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
+        "intercept": intercept,
+        "fitted_on": {"sweeps": [os.path.normpath(d) for d in args.sweeps], "scenes": scenes,
+                      "trials": len(trials), "frames": int(len(y)), "tracked": int(y.sum()),
+                      "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"},
+        "scores": {"train_auc": train_auc, "leave_one_scene_out_auc": loso,
+                   "leave_one_scene_out_auc_with_motion": loso_motion},
+        "suggested_min_track_probability": threshold,
+        "class_flyable_accuracy_there": accuracy, "oracle_trials": flights,
+    }
+    text = json.dumps(doc, indent=2) + "\n"
+    tmp = args.out + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(text)
+    os.replace(tmp, args.out)
+    print(f"fitted on {len(trials)} trials of {len(scenes)} scenes, {len(y)} frames ({int(y.sum())} tracked): "
+          f"training AUC {train_auc:.3f}, leave-one-scene-out AUC {loso:.3f} "
+          f"(with speed and yaw rate {loso_motion:.3f}) -> {args.out}")
+    for n, w in zip(FEATURES, weights):
+        print(f"  {n:22s} weight {w:+.3f}")
+    print(f"  class flyable (every frame at or above p) on its {flights} oracle trials: best p = {threshold:.2f}, "
+          f"{accuracy:.3f} right")
+
+
+def class_flyable(trials, threshold):
+    """(right, of) over the oracle trials: every frame at or above threshold <=> the VO never lost."""
+    right = n = 0
+    for tr in trials:
+        if tr["oracle"] < 0:
+            continue
+        n += 1
+        right += bool((tr["p"] >= threshold).all()) == bool(tr["y"].all())
+    return right, n
+
+
+def choose_threshold(trials, mean, scale, weights, intercept):
+    """The probability threshold with the most right "class flyable" calls on the oracle trials
+    (the highest of equals: the cautious one), its accuracy and the number of trials."""
+    for tr in trials:
+        tr["p"] = probability(tr["x"], mean, scale, weights, intercept)
+    best = (0.5, -1, 0)
+    for threshold in np.round(np.arange(0.05, 0.96, 0.05), 2):
+        right, n = class_flyable(trials, threshold)
+        if right >= best[1]:
+            best = (float(threshold), right, n)
+    return best[0], (best[1] / best[2] if best[2] else float("nan")), best[2]
+
+
+def load_model(path):
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except (OSError, ValueError) as e:
+        raise InputError(f"{path}: cannot read the model ({e})")
+    if doc.get("format") != "tgnav-track-model" or doc.get("features") != FEATURES:
+        raise InputError(f"{path}: key 'features' has value '{doc.get('features')}', expected {FEATURES}")
+    return (np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]), float(doc["intercept"]),
+            hashlib.sha256(open(path, "rb").read()).hexdigest()[:16])
+
+
+def reliability(y, p, bins=10):
+    edges = np.linspace(0, 1, bins + 1)
+    rows = []
+    for i in range(bins):
+        sel = (p >= edges[i]) & ((p < edges[i + 1]) if i + 1 < bins else (p <= 1))
+        if sel.sum():
+            rows.append((edges[i], edges[i + 1], int(sel.sum()), float(p[sel].mean()), float(y[sel].mean())))
+    return rows
+
+
+def cmd_evaluate(args):
+    mean, scale, weights, intercept, sha = load_model(args.model)
+    trials = read_sweeps(args.sweeps, args.min_z)
+    for tr in trials:
+        tr["p"] = probability(tr["x"], mean, scale, weights, intercept)
+    y, p = stack(trials, "y"), stack(trials, "p")
+    result = {"model": os.path.normpath(args.model), "model_sha256_16": sha,
+              "sweeps": [os.path.normpath(d) for d in args.sweeps], "trials": len(trials), "frames": int(len(y)),
+              "tracked": int(y.sum()), "roc_auc": auc(y, p), "threshold": args.threshold}
+    rel = reliability(y, p)
+    result["reliability"] = [{"from": a, "to": b, "frames": n, "mean_predicted": mp, "tracked": ot}
+                             for a, b, n, mp, ot in rel]
+    # class flyable (oracle trials): predicted = every airborne frame of the flown class at or above
+    # the threshold; flown = the VO never lost.
+    confusion = {"tp": 0, "fp": 0, "tn": 0, "fn": 0}
+    per_trial = []
+    for tr in trials:
+        if tr["oracle"] < 0:
+            continue
+        predicted = bool((tr["p"] >= args.threshold).all())
+        flown = bool(tr["y"].all())
+        key = ("t" if predicted == flown else "f") + ("p" if predicted else "n")
+        confusion[key] += 1
+        per_trial.append({"trial": os.path.basename(tr["folder"]), "predicted_flyable": predicted,
+                          "vo_kept": flown, "min_probability": float(tr["p"].min())})
+    n = sum(confusion.values())
+    result["class_flyable_by_threshold"] = [
+        {"threshold": float(th), "right": r, "of": k}
+        for th in np.round(np.arange(0.1, 0.91, 0.1), 1) for r, k in [class_flyable(trials, th)]]
+    result["class_flyable"] = dict(confusion, accuracy=(confusion["tp"] + confusion["tn"]) / n if n else float("nan"),
+                                   trials=per_trial)
+    os.makedirs(args.out, exist_ok=True)
+    with open(os.path.join(args.out, "reliability.csv"), "w") as f:
+        f.write("from,to,frames,mean_predicted,tracked\n")
+        for a, b, k, mp, ot in rel:
+            f.write(f"{a:.2f},{b:.2f},{k},{mp:.4f},{ot:.4f}\n")
+    with open(os.path.join(args.out, "evaluation.json"), "w") as f:
+        json.dump(result, f, indent=2)
+        f.write("\n")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        from sklearn.metrics import roc_curve
+        fig, ax = plt.subplots(1, 2, figsize=(9, 4))
+        ax[0].plot([0, 1], [0, 1], color="0.6", lw=1)
+        ax[0].plot([r[3] for r in rel], [r[4] for r in rel], "o-")
+        for r in rel:
+            ax[0].annotate(str(r[2]), (r[3], r[4]), fontsize=7, xytext=(3, -9), textcoords="offset points")
+        ax[0].set(xlabel="predicted probability of tracking", ylabel="share of frames tracked",
+                  title="reliability (frames per bin)", xlim=(0, 1), ylim=(0, 1.02))
+        fpr, tpr, _ = roc_curve(y, p)
+        ax[1].plot(fpr, tpr)
+        ax[1].plot([0, 1], [0, 1], color="0.6", lw=1)
+        ax[1].set(xlabel="false positive rate", ylabel="true positive rate",
+                  title=f"ROC, AUC {result['roc_auc']:.3f} ({len(y)} frames)")
+        fig.tight_layout()
+        fig.savefig(os.path.join(args.out, "reliability.png"), dpi=120)
+    except ImportError:
+        print("fit_track_model.py: figures skipped: matplotlib is not installed", file=sys.stderr)
+    cf = result["class_flyable"]
+    print(f"{len(trials)} trials, {len(y)} frames ({int(y.sum())} tracked): per-frame ROC AUC {result['roc_auc']:.3f}; "
+          f"class flyable at p >= {args.threshold}: {cf['tp'] + cf['tn']}/{n} right "
+          f"(tp {cf['tp']}, fp {cf['fp']}, tn {cf['tn']}, fn {cf['fn']}) -> {args.out}")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    f = sub.add_parser("fit")
+    f.add_argument("sweeps", nargs="+")
+    f.add_argument("--out", required=True)
+    f.add_argument("--c", type=float, default=1.0, help="inverse L2 regularisation of the logistic regression")
+    f.add_argument("--min-z", type=float, default=0.5)
+    e = sub.add_parser("evaluate")
+    e.add_argument("sweeps", nargs="+")
+    e.add_argument("--model", required=True)
+    e.add_argument("--out", required=True)
+    e.add_argument("--threshold", type=float, default=0.5)
+    e.add_argument("--min-z", type=float, default=0.5)
+    args = ap.parse_args()
+    try:
+        cmd_fit(args) if args.command == "fit" else cmd_evaluate(args)
+    except InputError as err:
+        print(f"fit_track_model.py: {err}", file=sys.stderr)
+        sys.exit(2)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,114 @@
+// The learned perception model's file (harness/config/track_model_file.h) and the scenario key
+// that names it: a good file gives the model the planner evaluates; a missing or malformed one is
+// one line naming the file and the key.
+#include "harness/config/track_model_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "harness/base/errors.h"
+#include "harness/config/scenario.h"
+#include "harness/config/yaml_util.h"
+#include "planner/perception.h"
+#include "test_util.h"
+
+namespace tgnav::harness {
+namespace {
+
+using test::inputError;
+
+const char* kGood = R"({"format": "tgnav-track-model", "version": 1, "kind": "logistic",
+  "features": ["log_detections", "coverage"], "mean": [3.0, 0.2], "scale": [0.5, 0.1],
+  "weights": [2.0, -1.0], "intercept": 0.25, "fitted_on": {"scenes": ["room-501"]}})";
+
+TEST(TrackModelFile, ReadsAGoodFile) {
+  const auto file = test::writeFile(test::tempDir() / "model.json", kGood);
+  const planner::TrackModel m = loadTrackModel(file);
+  ASSERT_EQ(m.terms.size(), 2u);
+  EXPECT_EQ(m.terms[0].feature, planner::TrackFeature::kLogDetections);
+  EXPECT_EQ(m.terms[1].feature, planner::TrackFeature::kCoverage);
+  EXPECT_EQ(m.terms[1].mean, 0.2);
+  EXPECT_EQ(m.terms[0].scale, 0.5);
+  EXPECT_EQ(m.terms[1].weight, -1.0);
+  EXPECT_EQ(m.intercept, 0.25);
+  planner::ViewSupport s;
+  s.detections = std::exp(3.0) - 1.0;                   // log1p: the mean
+  for (int cell = 0; cell < 12; ++cell) s.cover(cell);  // coverage 0.25: half a scale above
+  EXPECT_NEAR(m.probability(s), 1.0 / (1.0 + std::exp(-(0.25 - 0.5))), 1e-12);
+}
+
+TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
+  const auto dir = test::tempDir();
+  const std::string good = kGood;
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    text.replace(text.find(from), from.size(), to);
+    return text;
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"{", "not JSON"},
+      {"[1, 2]", "expected a JSON object"},
+      {with("\"tgnav-track-model\"", "\"other\""), "key 'format' has value '\"other\"'"},
+      {with("\"version\": 1", "\"version\": 2"), "key 'version' has value '2'"},
+      {with("\"logistic\"", "\"tree\""), "key 'kind' has value '\"tree\"'"},
+      {with("\"coverage\"]", "\"colour\"]"),
+       "key 'features[1]' has value '\"colour\"', expected one of log_detections"},
+      {with("\"features\": [\"log_detections\", \"coverage\"]", "\"features\": []"), "key 'features' has value '[]'"},
+      {with("[3.0, 0.2]", "[3.0]"), "key 'mean' has value '[3.0]', expected an array of 2 numbers"},
+      {with("[0.5, 0.1]", "[0.5, 0]"), "key 'scale[1]' has value '0.000000', expected > 0"},
+      {with("[2.0, -1.0]", "[2.0, \"x\"]"), "key 'weights[1]' has value '\"x\"', expected a number"},
+      {with("\"intercept\": 0.25", "\"intercept\": 1e999"), "not JSON"},
+      {with("\"intercept\": 0.25,", ""), "key 'intercept' is missing"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const auto file = test::writeFile(dir / "bad.json", text);
+    const std::string msg = inputError([&] { loadTrackModel(file); });
+    EXPECT_EQ(msg.rfind(file.string() + ": ", 0), 0u) << msg;
+    EXPECT_NE(msg.find(expected), std::string::npos) << "got: " << msg << "\nexpected: " << expected;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+  }
+  EXPECT_EQ(inputError([&] { loadTrackModel(dir / "none.json"); }), (dir / "none.json").string() + ": cannot read");
+}
+
+class TrackModelScenario : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::tempDir(); }
+  std::filesystem::path scenario(const std::string& body) {
+    return test::writeFile(
+        dir_ / "scenario.yaml",
+        "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(TrackModelScenario, AScenarioNamesItsModelRelativeToItself) {
+  test::writeFile(dir_ / "model.json", kGood);
+  const Scenario s = loadScenario(scenario("planner: {information: {track_model: model.json}}\n"));
+  ASSERT_NE(s.planner.perception.information.model, nullptr);
+  EXPECT_EQ(s.planner.perception.information.track_model, (dir_ / "model.json").string());
+  EXPECT_EQ(s.planner.rrt_star.information.model, s.planner.perception.information.model);  // one sensor model
+  EXPECT_EQ(loadScenario(scenario("")).planner.perception.information.model, nullptr);      // none: the gates
+}
+
+TEST_F(TrackModelScenario, AMissingModelIsNamedWithItsKey) {
+  const auto file = scenario("planner: {information: {track_model: nowhere.json}}\n");
+  EXPECT_EQ(inputError([&] { loadScenario(file); }),
+            file.string() + ": key 'planner.information.track_model' has value 'nowhere.json': file " +
+                (dir_ / "nowhere.json").string() + " not found");
+  const YamlDoc overrides = YamlDoc::fromOverrides({"planner.information.track_model=/no/such/model.json"});
+  EXPECT_EQ(inputError([&] { loadScenario(scenario(""), &overrides); }),
+            "--set: key 'planner.information.track_model' has value '/no/such/model.json': file /no/such/model.json "
+            "not found");
+  test::writeFile(dir_ / "bad.json", "{}");
+  const YamlDoc bad = YamlDoc::fromOverrides({"planner.information.track_model=" + (dir_ / "bad.json").string()});
+  EXPECT_EQ(inputError([&] { loadScenario(scenario(""), &bad); }),
+            (dir_ / "bad.json").string() + ": key 'format' is missing");
+  const YamlDoc p = YamlDoc::fromOverrides({"planner.information.min_track_probability=1"});
+  EXPECT_EQ(inputError([&] { loadScenario(scenario(""), &p); }),
+            "--set planner.information.min_track_probability=1: min_track_probability = 1: must be in (0, 1)");
+}
+
+}  // namespace
+}  // namespace tgnav::harness

@@ -1,0 +1,128 @@
+"""scripts/fit_track_model.py on synthetic sweeps: it recovers a known rule (the VO tracks where
+the promised detections are many), writes a model file planner/track_model.h's reader takes,
+scores unseen trials (ROC AUC, reliability bins, class flyable against the oracle), and refuses
+bad input with one line naming the file and exit status 2.
+
+Run: TGNAV_SCRIPTS_DIR=scripts /usr/bin/python3 -m unittest -v test_fit_track_model (in tests/scripts).
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+sys.dont_write_bytecode = True
+SCRIPTS_DIR = os.environ.get("TGNAV_SCRIPTS_DIR") or os.path.join(os.path.dirname(__file__), "..", "..", "scripts")
+SCRIPT = os.path.join(SCRIPTS_DIR, "fit_track_model.py")
+
+import numpy as np  # noqa: E402
+
+HEADER = ("t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
+          "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
+          "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_track_probability,"
+          "ba_correction_m,ba_correction_rad,ba_outliers,keyframe_rule,reason")
+
+
+def write_trial(folder, rng, oracle=-1, detections_scale=1.0):
+    """A trial whose frames are tracked (>= 30 inliers) exactly where the detections exceed 40."""
+    os.makedirs(folder)
+    rows = []
+    for i in range(200):
+        det = detections_scale * rng.uniform(0, 120)
+        tracked = det > 40
+        inliers = int(30 + det) if tracked else int(det * 0.5)
+        status = "ok" if tracked or i == 0 else "lost"  # frame 0: the VO starts (no matches)
+        matches = 0 if i == 0 else 50
+        rows.append(f"{i * 0.05:.2f},{status},1000,900,{matches},{inliers},0,{i * 0.02:.3f},0,1.0,,,,"
+                    f"-10,{det * 5:.1f},{min(1, det / 150):.3f},{det:.3f},{det / 3:.3f},4.0,0.5,0.5,,,,,,")
+    with open(os.path.join(folder, "vo.csv"), "w") as f:
+        f.write(HEADER + "\n" + "\n".join(rows) + "\n")
+    with open(os.path.join(folder, "config.yaml"), "w") as f:
+        f.write(f"vo:\n  min_inliers: 30\nplanner:\n  oracle_class: {oracle}\n")
+
+
+def make_sweep(root, scenes, seed):
+    rng = np.random.default_rng(seed)
+    for s in scenes:
+        write_trial(os.path.join(root, "trials", f"{s}__proposed__s01"), rng)
+        write_trial(os.path.join(root, "trials", f"{s}__proposed__oracle_class0__s01"), rng, oracle=0)
+        write_trial(os.path.join(root, "trials", f"{s}__proposed__oracle_class1__s01"), rng, oracle=1,
+                    detections_scale=3.0)
+
+
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def write_text(path, text):
+    with open(path, "w") as f:
+        f.write(text)
+
+
+def run(*args):
+    return subprocess.run([sys.executable, SCRIPT, *args], capture_output=True, text=True)
+
+
+class FitTrackModel(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_fits_and_evaluates_a_known_rule(self):
+        calib = os.path.join(self.dir, "calib")
+        held = os.path.join(self.dir, "held")
+        make_sweep(calib, ["a-1", "a-2", "b-1"], 1)
+        make_sweep(held, ["c-1", "c-2"], 2)
+        model = os.path.join(self.dir, "model.json")
+        r = run("fit", calib, "--out", model)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = read_json(model)
+        self.assertEqual(doc["format"], "tgnav-track-model")
+        self.assertEqual(doc["version"], 1)
+        self.assertEqual(len(doc["weights"]), len(doc["features"]))
+        self.assertGreater(doc["scores"]["leave_one_scene_out_auc"], 0.95)
+        self.assertEqual(doc["fitted_on"]["scenes"], ["a-1", "a-2", "b-1"])
+        # the first frame of each trial (no matches: an initialisation) is not a sample
+        self.assertEqual(doc["fitted_on"]["frames"], 9 * 199)
+        out = os.path.join(self.dir, "eval")
+        r = run("evaluate", held, "--model", model, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        ev = read_json(os.path.join(out, "evaluation.json"))
+        self.assertGreater(ev["roc_auc"], 0.95)
+        self.assertEqual(sum(b["frames"] for b in ev["reliability"]), ev["frames"])
+        cf = ev["class_flyable"]
+        self.assertEqual(cf["tp"] + cf["fp"] + cf["tn"] + cf["fn"], 4)  # the oracle trials only
+        # class 1 trials (detections 3x: a few blind frames remain) and class 0 (often blind)
+        # are not flyable, and the model says so
+        self.assertEqual(cf["tn"], 4)
+        self.assertTrue(os.path.isfile(os.path.join(out, "reliability.png")))
+
+    def test_bad_input_is_one_line_and_exit_2(self):
+        calib = os.path.join(self.dir, "calib")
+        make_sweep(calib, ["a-1"], 1)
+        vo = os.path.join(calib, "trials", "a-1__proposed__s01", "vo.csv")
+        with open(vo) as f:
+            write_text(vo, f.read().replace("predicted_row_span", "row"))
+        r = run("fit", calib, "--out", os.path.join(self.dir, "m.json"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(vo, r.stderr)
+        self.assertIn("predicted_row_span", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "m.json")))
+        r = run("fit", os.path.join(self.dir, "nowhere"), "--out", os.path.join(self.dir, "m.json"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("nowhere: not a folder", r.stderr)
+        bad_model = os.path.join(self.dir, "bad.json")
+        write_text(bad_model, "{")
+        r = run("evaluate", calib, "--model", bad_model, "--out", os.path.join(self.dir, "e"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(bad_model, r.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
