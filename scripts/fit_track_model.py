@@ -183,8 +183,18 @@ def leave_one_scene_out(trials, c, with_motion=False):
     return auc(np.concatenate(ys), np.concatenate(ps))
 
 
+def select(trials, names):
+    """The trials with only the named feature columns (in FEATURES' order of `names`)."""
+    cols = [FEATURES.index(n) for n in names]
+    return [dict(tr, x=tr["x"][:, cols]) for tr in trials]
+
+
 def cmd_fit(args):
-    trials = read_sweeps(args.sweeps, args.min_z)
+    names = [n for n in args.features.split(",") if n]
+    unknown = [n for n in names if n not in FEATURES]
+    if unknown or not names:
+        raise InputError(f"--features: '{unknown[0] if unknown else args.features}' is not one of {', '.join(FEATURES)}")
+    trials = select(read_sweeps(args.sweeps, args.min_z), names)
     x, y = stack(trials, "x"), stack(trials, "y")
     if y.min() == y.max():
         raise InputError(f"{', '.join(args.sweeps)}: every frame has the same label; nothing to fit")
@@ -197,11 +207,12 @@ def cmd_fit(args):
     doc = {
         "format": "tgnav-track-model", "version": 1, "kind": "logistic",
         "label": "the VO tracks the frame with at least vo.min_inliers PnP inliers",
-        "features": FEATURES, "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
+        "features": names, "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
         "intercept": intercept,
         "fitted_on": {"sweeps": [os.path.normpath(d) for d in args.sweeps], "scenes": scenes,
                       "trials": len(trials), "frames": int(len(y)), "tracked": int(y.sum()),
-                      "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"},
+                      "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"
+                                 + f" --features {','.join(names)}"},
         "scores": {"train_auc": train_auc, "leave_one_scene_out_auc": loso,
                    "leave_one_scene_out_auc_with_motion": loso_motion},
         "suggested_min_track_probability": threshold,
@@ -215,7 +226,7 @@ def cmd_fit(args):
     print(f"fitted on {len(trials)} trials of {len(scenes)} scenes, {len(y)} frames ({int(y.sum())} tracked): "
           f"training AUC {train_auc:.3f}, leave-one-scene-out AUC {loso:.3f} "
           f"(with speed and yaw rate {loso_motion:.3f}) -> {args.out}")
-    for n, w in zip(FEATURES, weights):
+    for n, w in zip(names, weights):
         print(f"  {n:22s} weight {w:+.3f}")
     print(f"  class flyable (every frame at or above p) on its {flights} oracle trials: best p = {threshold:.2f}, "
           f"{accuracy:.3f} right")
@@ -251,10 +262,15 @@ def load_model(path):
             doc = json.load(f)
     except (OSError, ValueError) as e:
         raise InputError(f"{path}: cannot read the model ({e})")
-    if doc.get("format") != "tgnav-track-model" or doc.get("features") != FEATURES:
-        raise InputError(f"{path}: key 'features' has value '{doc.get('features')}', expected {FEATURES}")
-    return (np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]), float(doc["intercept"]),
-            hashlib.sha256(open(path, "rb").read()).hexdigest()[:16])
+    features = doc.get("features") if isinstance(doc, dict) else None
+    if not isinstance(doc, dict) or doc.get("format") != "tgnav-track-model":
+        raise InputError(f"{path}: key 'format' is not \"tgnav-track-model\"")
+    if not isinstance(features, list) or not features or any(n not in FEATURES for n in features):
+        raise InputError(f"{path}: key 'features' has value '{features}', expected names among {FEATURES}")
+    with open(path, "rb") as f:
+        sha = hashlib.sha256(f.read()).hexdigest()[:16]
+    return (features, np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]),
+            float(doc["intercept"]), sha)
 
 
 def reliability(y, p, bins=10):
@@ -268,14 +284,18 @@ def reliability(y, p, bins=10):
 
 
 def cmd_evaluate(args):
-    mean, scale, weights, intercept, sha = load_model(args.model)
-    trials = read_sweeps(args.sweeps, args.min_z)
+    names, mean, scale, weights, intercept, sha = load_model(args.model)
+    all_trials = read_sweeps(args.sweeps, args.min_z)
+    trials = select(all_trials, names)
     for tr in trials:
         tr["p"] = probability(tr["x"], mean, scale, weights, intercept)
     y, p = stack(trials, "y"), stack(trials, "p")
     result = {"model": os.path.normpath(args.model), "model_sha256_16": sha,
               "sweeps": [os.path.normpath(d) for d in args.sweeps], "trials": len(trials), "frames": int(len(y)),
               "tracked": int(y.sum()), "roc_auc": auc(y, p), "threshold": args.threshold}
+    # one feature alone, for comparison (the gates threshold detections and coverage)
+    x = stack(all_trials, "x")
+    result["single_feature_auc"] = {n: auc(y, x[:, i]) for i, n in enumerate(FEATURES)}
     rel = reliability(y, p)
     result["reliability"] = [{"from": a, "to": b, "frames": n, "mean_predicted": mp, "tracked": ot}
                              for a, b, n, mp, ot in rel]
@@ -341,6 +361,8 @@ def main():
     f.add_argument("--out", required=True)
     f.add_argument("--c", type=float, default=1.0, help="inverse L2 regularisation of the logistic regression")
     f.add_argument("--min-z", type=float, default=0.5)
+    f.add_argument("--features", default=",".join(FEATURES),
+                   help="comma-separated subset of the features the model uses (default: all)")
     e = sub.add_parser("evaluate")
     e.add_argument("sweeps", nargs="+")
     e.add_argument("--model", required=True)

@@ -38,8 +38,9 @@ std::vector<double> numbers(const std::filesystem::path& file, const Json& doc, 
                    std::to_string(n) + " numbers (one per feature)");
   }
   std::vector<double> out;
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
     out.push_back(number(file, array[i], std::string(key) + "[" + std::to_string(i) + "]"));
+  }
   return out;
 }
 
@@ -59,8 +60,9 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
     fail(file, "key 'format' has value '" + format.dump() + "', expected \"tgnav-track-model\"");
   }
   const Json& version = member(file, doc, "version");
-  if (version != 1)
+  if (version != 1) {
     fail(file, "key 'version' has value '" + version.dump() + "', expected 1 (this build reads version 1)");
+  }
   const Json& kind = member(file, doc, "kind");
   if (kind != "logistic") fail(file, "key 'kind' has value '" + kind.dump() + "', expected \"logistic\"");
   const Json& features = member(file, doc, "features");

@@ -89,6 +89,16 @@ class FitTrackModel(unittest.TestCase):
         self.assertEqual(doc["fitted_on"]["scenes"], ["a-1", "a-2", "b-1"])
         # the first frame of each trial (no matches: an initialisation) is not a sample
         self.assertEqual(doc["fitted_on"]["frames"], 9 * 199)
+        # a subset of the features: the file lists them, evaluate uses them
+        small = os.path.join(self.dir, "small.json")
+        r = run("fit", calib, "--out", small, "--features", "log_detections,coverage")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(read_json(small)["features"], ["log_detections", "coverage"])
+        r = run("evaluate", held, "--model", small, "--out", os.path.join(self.dir, "eval_small"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r = run("fit", calib, "--out", small, "--features", "log_detections,colour")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("'colour'", r.stderr)
         out = os.path.join(self.dir, "eval")
         r = run("evaluate", held, "--model", model, "--out", out)
         self.assertEqual(r.returncode, 0, r.stderr)
