@@ -46,18 +46,21 @@ class InputError(Exception):
     pass
 
 
-def config_value(config_path, section, key, default):
-    """A scalar of a trial's resolved config.yaml (`section:` then `  key: value`)."""
+def read_config(config_path):
+    """A trial's resolved config.yaml as a dict ({} when it cannot be read)."""
     try:
         import yaml
         with open(config_path) as f:
             doc = yaml.safe_load(f)
-        node = doc
-        for part in section.split("."):
-            node = node[part]
-        return node.get(key, default)
-    except (OSError, KeyError, TypeError, AttributeError):
-        return default
+        return doc if isinstance(doc, dict) else {}
+    except OSError:
+        return {}
+
+
+def config_value(config, section, key, default):
+    """config[section][key], or default."""
+    node = config.get(section)
+    return node.get(key, default) if isinstance(node, dict) else default
 
 
 def read_gt_yaw(path):
@@ -99,7 +102,8 @@ def read_trial(folder, min_z):
         raise InputError(f"{path}: a row does not parse ({e})")
     if len(t) == 0:
         return None
-    min_inliers = float(config_value(os.path.join(folder, "config.yaml"), "vo", "min_inliers", 30))
+    config = read_config(os.path.join(folder, "config.yaml"))
+    min_inliers = float(config_value(config, "vo", "min_inliers", 30))
     x = np.column_stack([np.log1p(raw[n]) if n in LOGGED else raw[n] for n in FEATURES])
     label = np.array([s != "lost" for s in status]) & (inliers >= min_inliers)
     lost = np.array([s == "lost" for s in status])
@@ -115,7 +119,7 @@ def read_trial(folder, min_z):
     if gt is not None and len(gt[0]) > 2:
         rate = np.gradient(gt[1], gt[0])
         yaw_rate = np.abs(np.interp(t, gt[0], rate))
-    oracle = config_value(os.path.join(folder, "config.yaml"), "planner", "oracle_class", -1)
+    oracle = config_value(config, "planner", "oracle_class", -1)
     scene = os.path.basename(folder).split("__")[0]
     return {"folder": folder, "scene": scene, "x": x[keep], "y": label[keep], "motion": np.column_stack(
         [speed, yaw_rate])[keep], "oracle": int(oracle) if oracle is not None else -1, "t": t[keep],

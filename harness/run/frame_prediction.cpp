@@ -18,18 +18,10 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   };
   const std::vector<planner::WeightedPoint> points =
       planner::aggregateSlots(voxels, voxels.visibleSlots(p, visibility, in_view));
-  planner::ViewSupport support;
-  const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &support);
   FramePrediction out;
-  out.score = planner::scoreInformation(info, support, information);
-  out.landmarks = static_cast<int>(support.landmarks);
-  out.detections = support.detections;
-  out.coverage = support.coverage();
-  out.near_detections = support.near_detections;
-  out.mean_range_m = support.meanRangeM();
-  out.column_span = support.columnSpan();
-  out.row_span = support.rowSpan();
-  if (information.model) out.track_probability = information.model->probability(support);
+  const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &out.support);
+  out.score = planner::scoreInformation(info, out.support, information);
+  if (information.model) out.track_probability = information.model->probability(out.support);
   return out;
 }
 

@@ -12,14 +12,10 @@ namespace tgnav::harness {
 struct FramePrediction {
   double score =
       0.0;  // log det of the Fisher information of the landmarks in view (eq. 6, as the pose graph scores a node)
-  int landmarks = 0;        // map landmarks that count (in the field of view, range, line of sight and incidence limit)
-  double detections = 0.0;  // the detections they promise (planner::ViewSupport::detections)
-  double coverage = 0.0;    // share of the image's cells that hold one of them (planner::ViewSupport)
-  // The learned model's inputs besides those (planner::trackFeatureValue) and its output.
-  double near_detections = 0.0;     // detections of landmarks within planner::kNearRangeM
-  double mean_range_m = 0.0;        // detection-weighted mean range
-  double column_span = 0.0;         // share of the image's columns holding a landmark
-  double row_span = 0.0;            // share of its rows
+  // The map landmarks that count (in the field of view, range, line of sight and incidence limit):
+  // their number, the detections they promise, the image cells they cover, their ranges (the
+  // learned model's inputs, planner::trackFeatureValue).
+  planner::ViewSupport support;
   double track_probability = -1.0;  // the model's probability that the VO tracks the frame; -1: no model
 };
 

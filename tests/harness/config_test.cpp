@@ -461,11 +461,7 @@ TEST(ConfigOverrides, MalformedAssignmentsAreNamed) {
 class ConfigScenario : public ::testing::Test {
  protected:
   void SetUp() override { dir_ = test::tempDir(); }
-  std::filesystem::path scenario(const std::string& body) {
-    return test::writeFile(
-        dir_ / "scenario.yaml",
-        "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
-  }
+  std::filesystem::path scenario(const std::string& body) { return test::smokeScenario(dir_, body); }
   std::string error(const std::filesystem::path& file, const std::vector<std::string>& set) {
     const YamlDoc overrides = YamlDoc::fromOverrides(set);
     return inputError([&] { loadScenario(file, &overrides); });

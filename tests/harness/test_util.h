@@ -41,6 +41,12 @@ inline std::filesystem::path writeFile(const std::filesystem::path& path, const 
   return path;
 }
 
+// dir/scenario.yaml on the smoke scene with seed 3, then `body` (more scenario keys).
+inline std::filesystem::path smokeScenario(const std::filesystem::path& dir, const std::string& body) {
+  return writeFile(dir / "scenario.yaml",
+                   "scene: " + (sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
+}
+
 // Runs a shell command line; its output (stderr included) and exit code.
 using CmdResult = harness::CommandResult;
 inline CmdResult runShell(const std::string& command) { return harness::runCommand(command); }

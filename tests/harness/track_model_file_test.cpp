@@ -75,11 +75,7 @@ TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
 class TrackModelScenario : public ::testing::Test {
  protected:
   void SetUp() override { dir_ = test::tempDir(); }
-  std::filesystem::path scenario(const std::string& body) {
-    return test::writeFile(
-        dir_ / "scenario.yaml",
-        "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
-  }
+  std::filesystem::path scenario(const std::string& body) { return test::smokeScenario(dir_, body); }
   std::filesystem::path dir_;
 };
 
