@@ -47,14 +47,16 @@ class InputError(Exception):
 
 
 def read_config(config_path):
-    """A trial's resolved config.yaml as a dict ({} when it cannot be read)."""
+    """A trial's resolved config.yaml as a dict ({} when the trial has none)."""
+    import yaml
     try:
-        import yaml
         with open(config_path) as f:
             doc = yaml.safe_load(f)
-        return doc if isinstance(doc, dict) else {}
     except OSError:
         return {}
+    except yaml.YAMLError as e:
+        raise InputError(f"{config_path}: not YAML ({str(e).splitlines()[0]})")
+    return doc if isinstance(doc, dict) else {}
 
 
 def config_value(config, section, key, default):
@@ -188,7 +190,7 @@ def leave_one_scene_out(trials, c, with_motion=False):
 
 
 def select(trials, names):
-    """The trials with only the named feature columns (in FEATURES' order of `names`)."""
+    """The trials with only the named feature columns, in the order of `names`."""
     cols = [FEATURES.index(n) for n in names]
     return [dict(tr, x=tr["x"][:, cols]) for tr in trials]
 
@@ -271,6 +273,9 @@ def load_model(path):
         raise InputError(f"{path}: key 'format' is not \"tgnav-track-model\"")
     if not isinstance(features, list) or not features or any(n not in FEATURES for n in features):
         raise InputError(f"{path}: key 'features' has value '{features}', expected names among {FEATURES}")
+    for key in ("mean", "scale", "weights", "intercept"):
+        if key not in doc:
+            raise InputError(f"{path}: key '{key}' is missing")
     with open(path, "rb") as f:
         sha = hashlib.sha256(f.read()).hexdigest()[:16]
     return (features, np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]),
