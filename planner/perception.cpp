@@ -137,6 +137,30 @@ std::vector<WeightedPoint> aggregateSlots(const VoxelMap& voxels, const std::vec
   return points;
 }
 
+namespace {
+
+// The horizontal test of inFieldOfView(): the bearing of d off yaw_rad within half the FoV.
+bool bearingWithin(const Eigen::Vector3d& d, double yaw_rad, const VisibilityConfig& visibility) {
+  const double bearing = std::remainder(std::atan2(d.y(), d.x()) - yaw_rad, 2.0 * M_PI);
+  return std::abs(bearing) <= 0.5 * visibility.hfov_rad;
+}
+
+}  // namespace
+
+double coarseAtan2(double y, double x) {
+  const double ax = std::abs(x);
+  const double ay = std::abs(y);
+  const double hi = std::max(ax, ay);
+  if (!(hi > 0.0)) return 0.0;
+  const double a = std::min(ax, ay) / hi;  // the octant's tangent, in [0, 1]
+  const double s = a * a;
+  double r =
+      a * (0.99997726 + s * (-0.33262347 + s * (0.19354346 + s * (-0.11643287 + s * (0.05265332 + s * -0.01172120)))));
+  if (ay > ax) r = 0.5 * M_PI - r;
+  if (x < 0.0) r = M_PI - r;
+  return y < 0.0 ? -r : r;
+}
+
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility) {
   const Eigen::Vector3d d = l_W - p_W;
@@ -144,8 +168,37 @@ bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vect
   if (range < visibility.min_range_m || range > visibility.max_range_m) return false;
   const double horizontal = d.head<2>().norm();
   if (std::atan2(std::abs(d.z()), horizontal) > 0.5 * visibility.vfov_rad) return false;
-  const double bearing = std::remainder(std::atan2(d.y(), d.x()) - yaw_rad, 2.0 * M_PI);
-  return std::abs(bearing) <= 0.5 * visibility.hfov_rad;
+  return bearingWithin(d, yaw_rad, visibility);
+}
+
+FieldOfView::FieldOfView(double yaw_rad, const VisibilityConfig& visibility)
+    : yaw_rad_(yaw_rad),
+      visibility_(&visibility),
+      cos_yaw_(std::cos(yaw_rad)),
+      sin_yaw_(std::sin(yaw_rad)),
+      tan_half_hfov_(std::tan(0.5 * visibility.hfov_rad)),
+      tan_half_vfov_(std::tan(0.5 * visibility.vfov_rad)) {}
+
+bool FieldOfView::operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const {
+  const VisibilityConfig& visibility = *visibility_;
+  const Eigen::Vector3d d = l_W - p_W;
+  const double range = d.norm();
+  if (range < visibility.min_range_m || range > visibility.max_range_m) return false;
+  const double horizontal = d.head<2>().norm();
+  if (!(visibility.vfov_rad > 0.0 && visibility.vfov_rad < M_PI && visibility.hfov_rad > 0.0 &&
+        visibility.hfov_rad < M_PI)) {
+    return inFieldOfView(p_W, yaw_rad_, l_W, visibility);  // outside what the shortcuts assume
+  }
+  if (!withinHalfAngle(std::abs(d.z()), horizontal, 0.5 * visibility.vfov_rad, tan_half_vfov_)) return false;
+  // |left| <= tan(hfov / 2) forward is the bearing test in the yaw's frame; it is off the
+  // arctangent's answer only within a rounding error of the edge, which the margin holds.
+  const double forward = cos_yaw_ * d.x() + sin_yaw_ * d.y();
+  const double left = std::abs(cos_yaw_ * d.y() - sin_yaw_ * d.x());
+  const double edge = tan_half_hfov_ * forward;
+  const double margin = 1e-9 * horizontal;
+  if (left < edge - margin) return true;
+  if (left > edge + margin) return false;
+  return bearingWithin(d, yaw_rad_, visibility);
 }
 
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
@@ -153,8 +206,9 @@ Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::
   Matrix6d info = Matrix6d::Zero();
   ViewSupport view;
   const ImageCells cell(yaw_rad, visibility);
+  const FieldOfView in_view(yaw_rad, visibility);
   for (const WeightedPoint& pt : points) {
-    if (inFieldOfView(p_W, yaw_rad, pt.p_W, visibility) && withinIncidence(p_W, pt, config)) {
+    if (in_view(p_W, pt.p_W) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
       view.add(pt, (pt.p_W - p_W).norm(), cell(p_W, pt.p_W));
     }

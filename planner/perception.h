@@ -174,9 +174,30 @@ inline bool withinHalfAngle(double opposite, double adjacent, double half_angle,
   return std::atan2(opposite, adjacent) <= half_angle;
 }
 
+// std::atan2(y, x) to within 1e-5 rad, without the library call (a polynomial on the octant);
+// 0 for (0, 0) and for NaN. For choosing which bins to test exactly, never for an answer.
+double coarseAtan2(double y, double x);
+
 // True if a level camera at p_W looking along yaw_rad sees l_W within range and both FoVs.
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility);
+
+// inFieldOfView() for many points seen from one yaw: the same answers, its trigonometry done once
+// and the arctangents skipped where a comparison decides by a margin far beyond their rounding
+// (as withinHalfAngle()). `visibility` must outlive it.
+class FieldOfView {
+ public:
+  FieldOfView(double yaw_rad, const VisibilityConfig& visibility);
+  bool operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const;
+
+ private:
+  double yaw_rad_;
+  const VisibilityConfig* visibility_;
+  double cos_yaw_;
+  double sin_yaw_;
+  double tan_half_hfov_;
+  double tan_half_vfov_;
+};
 
 // Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose that
 // are within the incidence limit; `support` (optional): their weight and image cells.

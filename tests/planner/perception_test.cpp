@@ -48,6 +48,52 @@ TEST(WithinHalfAngle, AgreesWithTheArctangentEverywhere) {
   EXPECT_GT(outside, 50000);
 }
 
+// coarseAtan2() is within 1e-5 rad of std::atan2 in every quadrant, on the axes and at (0, 0).
+TEST(CoarseAtan2, WithinItsStatedErrorEverywhere) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> coord(-10.0, 10.0);
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double y = i % 97 == 0 ? 0.0 : coord(rng);
+    const double x = i % 89 == 0 ? 0.0 : coord(rng);
+    worst = std::max(worst, std::abs(coarseAtan2(y, x) - std::atan2(y, x)));
+  }
+  EXPECT_LT(worst, 1e-5);
+  EXPECT_GT(worst, 0.0);  // it is an approximation: the tests that rely on exactness must not
+  EXPECT_EQ(coarseAtan2(0.0, 0.0), 0.0);
+  EXPECT_NEAR(coarseAtan2(1.0, -1.0), 0.75 * M_PI, 1e-5);
+  EXPECT_NEAR(coarseAtan2(-2.0, 0.0), -0.5 * M_PI, 1e-5);
+}
+
+// FieldOfView gives inFieldOfView()'s answer for every point: at random, near the horizontal
+// FoV's edges (where only the arctangent decides), behind the camera and at every yaw.
+TEST(FieldOfView, AgreesWithInFieldOfViewEverywhere) {
+  const VisibilityConfig vis;
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int inside = 0;
+  int outside = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double yaw = (i % 50 == 0) ? 0.25 * M_PI * (i % 8) : 2.0 * M_PI * unit(rng) - M_PI;
+    const FieldOfView in_view(yaw, vis);
+    const Eigen::Vector3d p(10.0 * unit(rng), 10.0 * unit(rng), 2.0 * unit(rng));
+    const double range = 8.0 * unit(rng);
+    // A third of the points within 3e-9 rad of a side edge of the image, the rest anywhere.
+    const double bearing = i % 3 == 0
+                               ? (i % 2 == 0 ? 1.0 : -1.0) * (0.5 * vis.hfov_rad + 3e-9 * (2.0 * unit(rng) - 1.0))
+                               : 2.0 * M_PI * unit(rng);
+    const double elevation = (unit(rng) - 0.5) * vis.vfov_rad * 1.2;
+    const Eigen::Vector3d l =
+        p + range * Eigen::Vector3d(std::cos(elevation) * std::cos(yaw + bearing),
+                                    std::cos(elevation) * std::sin(yaw + bearing), std::sin(elevation));
+    const bool expected = inFieldOfView(p, yaw, l, vis);
+    ASSERT_EQ(in_view(p, l), expected) << i;
+    (expected ? inside : outside) += 1;
+  }
+  EXPECT_GT(inside, 30000);
+  EXPECT_GT(outside, 30000);
+}
+
 TEST(ImageCell, CornersCentreAndSidesOfTheImage) {
   const VisibilityConfig vis;
   const Eigen::Vector3d o = Eigen::Vector3d::Zero();
