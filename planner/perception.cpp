@@ -147,20 +147,6 @@ bool bearingWithin(const Eigen::Vector3d& d, double yaw_rad, const VisibilityCon
 
 }  // namespace
 
-double coarseAtan2(double y, double x) {
-  const double ax = std::abs(x);
-  const double ay = std::abs(y);
-  const double hi = std::max(ax, ay);
-  if (!(hi > 0.0)) return 0.0;
-  const double a = std::min(ax, ay) / hi;  // the octant's tangent, in [0, 1]
-  const double s = a * a;
-  double r =
-      a * (0.99997726 + s * (-0.33262347 + s * (0.19354346 + s * (-0.11643287 + s * (0.05265332 + s * -0.01172120)))));
-  if (ay > ax) r = 0.5 * M_PI - r;
-  if (x < 0.0) r = M_PI - r;
-  return y < 0.0 ? -r : r;
-}
-
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility) {
   const Eigen::Vector3d d = l_W - p_W;

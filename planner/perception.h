@@ -174,10 +174,6 @@ inline bool withinHalfAngle(double opposite, double adjacent, double half_angle,
   return std::atan2(opposite, adjacent) <= half_angle;
 }
 
-// std::atan2(y, x) to within 1e-5 rad, without the library call (a polynomial on the octant);
-// 0 for (0, 0) and for NaN. For choosing which bins to test exactly, never for an answer.
-double coarseAtan2(double y, double x);
-
 // True if a level camera at p_W looking along yaw_rad sees l_W within range and both FoVs.
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility);

@@ -179,34 +179,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const int half_window = static_cast<int>(std::ceil(0.5 * visibility.hfov_rad / yaw_step)) + 1;
   const double tan_half_vfov = std::tan(0.5 * visibility.vfov_rad);
   std::vector<double> yaw_of(static_cast<std::size_t>(yaws));
-  std::vector<double> cos_of(static_cast<std::size_t>(yaws));
-  std::vector<double> sin_of(static_cast<std::size_t>(yaws));
   std::vector<ImageCells> cells_of;
   cells_of.reserve(static_cast<std::size_t>(yaws));
   for (int k = 0; k < yaws; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    yaw_of[ku] = wrapAngle(yaw0 + k * yaw_step);
-    cos_of[ku] = std::cos(yaw_of[ku]);
-    sin_of[ku] = std::sin(yaw_of[ku]);
-    cells_of.emplace_back(yaw_of[ku], visibility);
+    yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
+    cells_of.emplace_back(yaw_of[static_cast<std::size_t>(k)], visibility);
   }
-  const double half_hfov = 0.5 * visibility.hfov_rad;
-  const double tan_half_hfov = std::tan(half_hfov);
-  const bool bearing_shortcut = visibility.hfov_rad > 0.0 && visibility.hfov_rad < M_PI;
-  // |wrapAngle(atan2(d.y, d.x) - yaw_of[idx])| <= hfov / 2. Where |left| against tan(hfov / 2)
-  // forward in the yaw's frame decides by a margin far beyond both sides' rounding (as
-  // withinHalfAngle()), that comparison answers; near the edge, the arctangent does.
-  auto bearingHolds = [&](const Eigen::Vector3d& d, double horizontal, std::size_t idx) {
-    if (bearing_shortcut) {
-      const double forward = cos_of[idx] * d.x() + sin_of[idx] * d.y();
-      const double left = std::abs(cos_of[idx] * d.y() - sin_of[idx] * d.x());
-      const double edge = tan_half_hfov * forward;
-      const double margin = 1e-9 * horizontal;
-      if (left < edge - margin) return true;
-      if (left > edge + margin) return false;
-    }
-    return std::abs(wrapAngle(std::atan2(d.y(), d.x()) - yaw_of[idx])) <= half_hfov;
-  };
   const std::vector<bool> turn_ok =
       free_start && !std::isnan(turn_from_yaw_rad) && config.guard_start_turn && !path.empty()
           ? startTurnAllowed(path.front(), yaw_of, voxels, visibility, information, config.turn_floor)
@@ -254,20 +232,19 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         const double range = d.norm();
         if (range < visibility.min_range_m || range > visibility.max_range_m) return;
         if (!withinIncidence(p, pt, information)) return;
-        const double horizontal = d.head<2>().norm();
-        if (!withinHalfAngle(std::abs(d.z()), horizontal, 0.5 * visibility.vfov_rad, tan_half_vfov)) return;
+        if (!withinHalfAngle(std::abs(d.z()), d.head<2>().norm(), 0.5 * visibility.vfov_rad, tan_half_vfov)) return;
+        const double azimuth = std::atan2(d.y(), d.x());
         const bool all = 2 * half_window + 1 >= yaws;
         // The window only has to hold every yaw that can see pt (it has a spare yaw each side),
-        // so the bin nearest the azimuth may round either way, and a coarse azimuth (off by far
-        // less than half a yaw step) finds it; each yaw is then tested exactly.
-        const double bin = all ? 0.0 : (coarseAtan2(d.y(), d.x()) - yaw0) / yaw_step;
+        // so the bin nearest the azimuth may round either way; each yaw is then tested exactly.
+        const double bin = (azimuth - yaw0) / yaw_step;
         const int nearest = all ? 0 : static_cast<int>(bin + (bin >= 0.0 ? 0.5 : -0.5));
         const int first = all ? 0 : nearest - half_window;
         const int last = all ? yaws - 1 : nearest + half_window;
         int idx = first % yaws;
         if (idx < 0) idx += yaws;
         for (int k = first; k <= last; ++k) {
-          if (bearingHolds(d, horizontal, static_cast<std::size_t>(idx))) {
+          if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
             add(static_cast<std::size_t>(idx));
           }
           if (++idx == yaws) idx = 0;

@@ -48,23 +48,6 @@ TEST(WithinHalfAngle, AgreesWithTheArctangentEverywhere) {
   EXPECT_GT(outside, 50000);
 }
 
-// coarseAtan2() is within 1e-5 rad of std::atan2 in every quadrant, on the axes and at (0, 0).
-TEST(CoarseAtan2, WithinItsStatedErrorEverywhere) {
-  std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> coord(-10.0, 10.0);
-  double worst = 0.0;
-  for (int i = 0; i < 200000; ++i) {
-    const double y = i % 97 == 0 ? 0.0 : coord(rng);
-    const double x = i % 89 == 0 ? 0.0 : coord(rng);
-    worst = std::max(worst, std::abs(coarseAtan2(y, x) - std::atan2(y, x)));
-  }
-  EXPECT_LT(worst, 1e-5);
-  EXPECT_GT(worst, 0.0);  // it is an approximation: the tests that rely on exactness must not
-  EXPECT_EQ(coarseAtan2(0.0, 0.0), 0.0);
-  EXPECT_NEAR(coarseAtan2(1.0, -1.0), 0.75 * M_PI, 1e-5);
-  EXPECT_NEAR(coarseAtan2(-2.0, 0.0), -0.5 * M_PI, 1e-5);
-}
-
 // FieldOfView gives inFieldOfView()'s answer for every point: at random, near the horizontal
 // FoV's edges (where only the arctangent decides), behind the camera and at every yaw.
 TEST(FieldOfView, AgreesWithInFieldOfViewEverywhere) {
