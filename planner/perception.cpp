@@ -163,7 +163,9 @@ FieldOfView::FieldOfView(double yaw_rad, const VisibilityConfig& visibility)
       cos_yaw_(std::cos(yaw_rad)),
       sin_yaw_(std::sin(yaw_rad)),
       tan_half_hfov_(std::tan(0.5 * visibility.hfov_rad)),
-      tan_half_vfov_(std::tan(0.5 * visibility.vfov_rad)) {}
+      tan_half_vfov_(std::tan(0.5 * visibility.vfov_rad)),
+      shortcuts_(visibility.vfov_rad > 0.0 && visibility.vfov_rad < M_PI && visibility.hfov_rad > 0.0 &&
+                 visibility.hfov_rad < M_PI) {}
 
 bool FieldOfView::operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const {
   const VisibilityConfig& visibility = *visibility_;
@@ -171,10 +173,7 @@ bool FieldOfView::operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& 
   const double range = d.norm();
   if (range < visibility.min_range_m || range > visibility.max_range_m) return false;
   const double horizontal = d.head<2>().norm();
-  if (!(visibility.vfov_rad > 0.0 && visibility.vfov_rad < M_PI && visibility.hfov_rad > 0.0 &&
-        visibility.hfov_rad < M_PI)) {
-    return inFieldOfView(p_W, yaw_rad_, l_W, visibility);  // outside what the shortcuts assume
-  }
+  if (!shortcuts_) return inFieldOfView(p_W, yaw_rad_, l_W, visibility);
   if (!withinHalfAngle(std::abs(d.z()), horizontal, 0.5 * visibility.vfov_rad, tan_half_vfov_)) return false;
   // |left| <= tan(hfov / 2) forward is the bearing test in the yaw's frame; it is off the
   // arctangent's answer only within a rounding error of the edge, which the margin holds.

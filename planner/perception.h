@@ -193,6 +193,7 @@ class FieldOfView {
   double sin_yaw_;
   double tan_half_hfov_;
   double tan_half_vfov_;
+  bool shortcuts_;  // both FoVs in (0, pi), as the comparisons assume; else inFieldOfView() answers
 };
 
 // Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose that
