@@ -13,11 +13,20 @@ void SegmentConfig::validate() const {
           "must be in [0, 1]");
 }
 
-double covisibilityRatio(const std::vector<int>& a, const std::vector<int>& b, std::vector<int>* intersection) {
+double covisibilityRatio(const std::vector<int>& a, const std::vector<int>& b, std::vector<int>* intersection,
+                         const KeyWeight& weight, int* common) {
   intersection->clear();
   std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(*intersection));
-  const std::size_t union_size = a.size() + b.size() - intersection->size();
-  return union_size == 0 ? 0.0 : static_cast<double>(intersection->size()) / static_cast<double>(union_size);
+  auto count = [&](const std::vector<int>& keys) {
+    if (!weight) return static_cast<long long>(keys.size());
+    long long n = 0;
+    for (int key : keys) n += weight(key);
+    return n;
+  };
+  const long long both = count(*intersection);
+  if (common != nullptr) *common = static_cast<int>(both);
+  const long long union_size = count(a) + count(b) - both;
+  return union_size == 0 ? 0.0 : static_cast<double>(both) / static_cast<double>(union_size);
 }
 
 double polylineLength3(const std::vector<Eigen::Vector3d>& path) {
@@ -37,7 +46,7 @@ Eigen::Vector3d pointAt(const std::vector<Eigen::Vector3d>& path, double s) {
 }
 
 std::vector<PathSegment> extractSegments(const std::vector<Eigen::Vector3d>& path, const SegmentConfig& config,
-                                         const VisibilityQuery& visible, int* queries) {
+                                         const VisibilityQuery& visible, int* queries, const KeyWeight& weight) {
   std::vector<PathSegment> segments;
   if (path.empty()) return segments;
   int calls = 0;
@@ -58,7 +67,7 @@ std::vector<PathSegment> extractSegments(const std::vector<Eigen::Vector3d>& pat
     Pending seg = std::move(stack.back());
     stack.pop_back();
     PathSegment out;
-    out.ratio = covisibilityRatio(seg.v0, seg.v1, &out.covisible);
+    out.ratio = covisibilityRatio(seg.v0, seg.v1, &out.covisible, weight, &out.covisible_landmarks);
     if (out.ratio >= config.covisibility_ratio || seg.s1 - seg.s0 <= config.min_length_m) {
       out.s_begin_m = seg.s0;
       out.s_end_m = seg.s1;

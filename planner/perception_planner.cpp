@@ -55,7 +55,7 @@ std::vector<ScoredSegment> scoreSegments(const std::vector<PathSegment>& segment
     ScoredSegment seg;
     seg.s_begin_m = segments[k].s_begin_m;
     seg.s_end_m = segments[k].s_end_m;
-    seg.covisible = static_cast<int>(segments[k].covisible.size());
+    seg.covisible = segments[k].covisible_landmarks;
     double sum = 0.0;
     int n = 0;
     for (std::size_t j = 0; j < graph.scores.size(); ++j) {
@@ -199,8 +199,8 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
     const std::vector<Eigen::Vector3d> path = lift(plan.topo.classes[i].path, z);
     ClassDetail& detail = plan.details[i];
     detail.segments = extractSegments(
-        path, config_.segments, [&](const Eigen::Vector3d& p) { return voxels_.visibleFrom(p, config_.visibility); },
-        &detail.visibility_queries);
+        path, config_.segments, [&](const Eigen::Vector3d& p) { return voxels_.visibleSlots(p, config_.visibility); },
+        &detail.visibility_queries, [&](int slot) { return voxels_.landmarksIn(slot); });
     detail.graph = searchPoseGraph(path, detail.segments, voxels_, config_.visibility, config_.information,
                                    config_.graph, config_.keep_start_yaw ? request.start.yaw_rad : std::nan(""),
                                    classSeed(request.seed, i), request.start.yaw_rad);

@@ -152,7 +152,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   // Landmarks of each segment's co-visible set, grouped by voxel once.
   std::vector<std::vector<WeightedPoint>> segment_points;
   segment_points.reserve(segments.size());
-  for (const PathSegment& seg : segments) segment_points.push_back(aggregateByVoxel(voxels, seg.covisible));
+  for (const PathSegment& seg : segments) segment_points.push_back(aggregateSlots(voxels, seg.covisible));
 
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

@@ -147,7 +147,8 @@ struct PoseGraphResult {
 };
 
 // `path` is the class's reference path (3D, start to goal), `segments` its segments (in order,
-// covering it). start_yaw_rad: the start node's yaw, or NaN to leave it free. turn_from_yaw_rad:
+// covering it; their co-visible sets as landmark-voxel slots of `voxels`, from extractSegments()
+// over VoxelMap::visibleSlots). start_yaw_rad: the start node's yaw, or NaN to leave it free. turn_from_yaw_rad:
 // with the start yaw free, the vehicle's yaw before it turns on the spot to the first node's: the
 // yaw lattice includes it and guard_start_turn checks the turn from it (NaN: unknown, no check).
 PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const std::vector<PathSegment>& segments,

@@ -49,6 +49,10 @@ class VoxelMap {
   const std::vector<LandmarkVoxel>& landmarkVoxels() const { return landmark_voxels_; }
   // Index into landmarkVoxels() of landmark `id` (-1: outside the box).
   int landmarkSlot(int id) const { return landmark_slot_.at(static_cast<std::size_t>(id)); }
+  // Number of landmarks in landmarkVoxels()[slot].
+  int landmarksIn(int slot) const {
+    return static_cast<int>(landmark_voxels_.at(static_cast<std::size_t>(slot)).ids.size());
+  }
   // Landmark::detectability() of landmark `id`.
   double detectability(int id) const { return detectability_.at(static_cast<std::size_t>(id)); }
 

@@ -260,5 +260,53 @@ TEST(Covisibility, ConfigValidationNamesTheField) {
   expectRejected(c, "min_length_m");
 }
 
+// The planner's query: V(p) as landmark voxels (VoxelMap::visibleSlots), each weighted by its
+// landmarks. The segments are those over ids: the same split points, ratios, and co-visible sets
+// (as voxels). The wall carries several landmarks per voxel so that the weights count.
+TEST(Covisibility, VoxelSlotsWeightedByLandmarksSplitAsIds) {
+  testing::SyntheticWorld w;
+  w.min_W = {0.0, 0.0, 0.0};
+  w.max_W = {10.0, 3.5, 2.5};
+  const Eigen::AlignedBox3d wall(Eigen::Vector3d(0.0, 3.0, 0.0), Eigen::Vector3d(4.0, 3.3, 2.5));
+  const Eigen::AlignedBox3d occluder(Eigen::Vector3d(4.0, 1.6, 0.0), Eigen::Vector3d(10.0, 1.7, 2.5));
+  w.solids = {wall, occluder};
+  w.texture(wall, Eigen::Vector3d(0, -1, 0), 0.04);
+  const FeatureMap map = w.build();
+  const VoxelMap voxels(map, w.min_W, w.max_W);
+  ASSERT_LT(voxels.landmarkVoxels().size(), map.landmarks().size() / 2);  // several per voxel
+  const VisibilityConfig vis;
+  const SegmentConfig config;
+  for (const std::vector<Eigen::Vector3d>& path :
+       {std::vector<Eigen::Vector3d>{{0.5, 1.45, 1.0}, {9.5, 1.45, 1.0}},
+        std::vector<Eigen::Vector3d>{{0.5, 0.5, 0.6}, {3.0, 2.2, 1.8}, {9.0, 1.0, 1.2}}}) {
+    const std::vector<PathSegment> by_ids =
+        extractSegments(path, config, [&](const Eigen::Vector3d& p) { return voxels.visibleFrom(p, vis); });
+    ASSERT_GT(by_ids.size(), 4u);
+    // Segments over voxel slots weighted by their landmarks (the planner's query) are those over
+    // ids: the same split points, ratios, and co-visible sets (as voxels).
+    const std::vector<PathSegment> by_slots = extractSegments(
+        path, config, [&](const Eigen::Vector3d& p) { return voxels.visibleSlots(p, vis); }, nullptr,
+        [&](int slot) { return voxels.landmarksIn(slot); });
+    ASSERT_EQ(by_slots.size(), by_ids.size());
+    bool weights_matter = false;
+    for (std::size_t k = 0; k < by_ids.size(); ++k) {
+      EXPECT_EQ(by_slots[k].s_begin_m, by_ids[k].s_begin_m);
+      EXPECT_EQ(by_slots[k].s_end_m, by_ids[k].s_end_m);
+      EXPECT_EQ(by_slots[k].ratio, by_ids[k].ratio);
+      EXPECT_EQ(by_slots[k].covisible_landmarks, static_cast<int>(by_ids[k].covisible.size()));
+      EXPECT_EQ(by_ids[k].covisible_landmarks, static_cast<int>(by_ids[k].covisible.size()));
+      std::vector<int> ids;
+      for (int slot : by_slots[k].covisible) {
+        const std::vector<int>& in = voxels.landmarkVoxels()[static_cast<std::size_t>(slot)].ids;
+        ids.insert(ids.end(), in.begin(), in.end());
+      }
+      std::sort(ids.begin(), ids.end());
+      EXPECT_EQ(ids, by_ids[k].covisible);
+      weights_matter = weights_matter || by_slots[k].covisible.size() != by_ids[k].covisible.size();
+    }
+    EXPECT_TRUE(weights_matter);  // voxels hold several landmarks here, so the weights are tested
+  }
+}
+
 }  // namespace
 }  // namespace tgnav::planner

@@ -225,8 +225,9 @@ InformationConfig syntheticInformation() {
 PoseGraphResult search(const Corridor& c, const PoseGraphConfig& config, std::uint64_t seed,
                        double start_yaw = std::nan("")) {
   const VisibilityConfig vis;
-  const std::vector<PathSegment> segments =
-      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return c.voxels.landmarksIn(slot); });
   return searchPoseGraph(c.path, segments, c.voxels, vis, syntheticInformation(), config, start_yaw, seed);
 }
 
@@ -371,15 +372,16 @@ TEST(PoseGraph, ChosenScoresMatchPoseScore) {
   const VisibilityConfig vis;
   InformationConfig info;
   info.min_image_coverage = 0.0;  // information alone (the coverage limit: ImageCoverageGatesOnWhatTheCameraSees)
-  const std::vector<PathSegment> segments =
-      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return c.voxels.landmarksIn(slot); });
   int checked = 0;
   for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
     const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
     ASSERT_TRUE(r.found);
     for (std::size_t j = 0; j < r.path.size(); ++j) {
       const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
-      const std::vector<WeightedPoint> points = aggregateByVoxel(c.voxels, seg.covisible);
+      const std::vector<WeightedPoint> points = aggregateSlots(c.voxels, seg.covisible);
       const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
       EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
           << "start yaw " << start_yaw << " layer " << j;
@@ -415,8 +417,9 @@ TEST(PoseGraph, StartTurnNeverSweepsABlindView) {
   const std::vector<Eigen::Vector3d> path = {{3.0, 5.0, kZ}, {7.0, 5.0, kZ}};
   const VisibilityConfig vis;
   const InformationConfig info;
-  const std::vector<PathSegment> segments =
-      extractSegments(path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments = extractSegments(
+      path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return voxels.landmarksIn(slot); });
   const std::vector<WeightedPoint> from_start = aggregateByVoxel(voxels, voxels.visibleFrom(path.front(), vis));
   auto view = [&](double yaw) { return poseScore(path.front(), yaw, from_start, vis, info); };
   const double vehicle_yaw = M_PI / 2;
@@ -463,8 +466,9 @@ TEST(PoseGraph, ImageCoverageGatesOnWhatTheCameraSees) {
   const VisibilityConfig vis;
   InformationConfig info;
   info.min_image_coverage = 0.3;
-  const std::vector<PathSegment> segments =
-      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return c.voxels.landmarksIn(slot); });
   const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, 0.0, 5);
   ASSERT_TRUE(r.found);
   const double blind = 6.0 * std::log(info.epsilon);
@@ -478,7 +482,7 @@ TEST(PoseGraph, ImageCoverageGatesOnWhatTheCameraSees) {
     poseInformation(r.path[j].p_WB, r.path[j].yaw_rad, seen, vis, info, &support);
     const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
     const double direct =
-        poseScore(r.path[j].p_WB, r.path[j].yaw_rad, aggregateByVoxel(c.voxels, seg.covisible), vis, ungated);
+        poseScore(r.path[j].p_WB, r.path[j].yaw_rad, aggregateSlots(c.voxels, seg.covisible), vis, ungated);
     if (support.coverage() < info.min_image_coverage) {
       EXPECT_DOUBLE_EQ(r.scores[j], blind) << "layer " << j;
       ++gated;
@@ -501,7 +505,8 @@ TEST(PoseGraph, WhereEveryPoseIsGatedTheYawStillFacesTheTexture) {
     InformationConfig info = syntheticInformation();
     info.min_detections = 5000.0;  // more than the corridor's 2000 landmarks
     const std::vector<PathSegment> segments = extractSegments(
-        c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+        c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+        [&](int slot) { return c.voxels.landmarksIn(slot); });
     const PoseGraphConfig config;
     const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, config, std::nan(""), 3);
     expectFeasible(c, r, config);
@@ -543,11 +548,13 @@ TEST(PoseGraph, MovesThatGoBlindBetweenTheirPosesAreAvoidedOrMarked) {
   all.s_end_m = 0.4;
   all.p_begin = path.front();
   all.p_end = path.back();
-  for (int id = 0; id < static_cast<int>(map.landmarks().size()); ++id) all.covisible.push_back(id);
+  for (std::size_t slot = 0; slot < voxels.landmarkVoxels().size(); ++slot) {
+    all.covisible.push_back(static_cast<int>(slot));
+  }
   InformationConfig info = syntheticInformation();
   info.min_image_coverage = 0.0;
   info.min_detections = 20.0;
-  const std::vector<WeightedPoint> points = aggregateByVoxel(voxels, all.covisible);
+  const std::vector<WeightedPoint> points = aggregateSlots(voxels, all.covisible);
   auto score = [&](double x, double yaw) { return poseScore({x, 0.0, kZ}, yaw, points, vis, info); };
   const double blind = 6.0 * std::log(info.epsilon);
   const double step = 2.0 * M_PI / PoseGraphConfig{}.yaw_samples;
@@ -601,8 +608,9 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   frozen.yaw_rate_limit_rad_s = 1e-6;
   for (double length : {2.9, 2.41, 1.25, 0.81}) {
     const std::vector<Eigen::Vector3d> path{{0.5, 1.5, kZ}, {0.5 + length, 1.5, kZ}};
-    const std::vector<PathSegment> segments =
-        extractSegments(path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+    const std::vector<PathSegment> segments = extractSegments(
+        path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+        [&](int slot) { return c.voxels.landmarksIn(slot); });
     const PoseGraphResult a =
         searchPoseGraph(path, segments, c.voxels, vis, InformationConfig{}, defaults, std::nan(""), 9);
     const PoseGraphResult b =
@@ -621,8 +629,9 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   ASSERT_NO_THROW(fine.validate());
   PoseGraphConfig fine_frozen = fine;
   fine_frozen.yaw_rate_limit_rad_s = 1e-6;
-  const std::vector<PathSegment> segments =
-      extractSegments(c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleFrom(p, vis); });
+  const std::vector<PathSegment> segments = extractSegments(
+      c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return c.voxels.landmarksIn(slot); });
   const PoseGraphResult a =
       searchPoseGraph(c.path, segments, c.voxels, vis, InformationConfig{}, fine, std::nan(""), 9);
   const PoseGraphResult b =
