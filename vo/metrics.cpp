@@ -3,9 +3,10 @@
 #include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
-#include <iterator>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "vo/text_fields.h"
 
@@ -19,18 +20,54 @@ constexpr double kDegenerateRatio = 1e-9;
 // Shortest text that reads back to v (std::to_string would print 1e-9 as 0.000000).
 using text::str;
 
-// Finite, strictly increasing timestamps; the message names the sequence and the index.
+// Finite timestamps; the message names the sequence and the index.
 void checkTimes(const std::vector<StampedPose>& poses, const char* name) {
-  auto at = [&](std::size_t i) { return std::string(name) + "[" + std::to_string(i) + "]"; };
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    const double t = poses[i].t_s;
-    if (!std::isfinite(t)) throw std::invalid_argument("associate: " + at(i) + " has a non-finite timestamp");
-    if (i > 0 && !(t > poses[i - 1].t_s)) {
-      throw std::invalid_argument("associate: " + at(i) + " timestamp " + str(t) + " is not after " + at(i - 1) + " (" +
-                                  str(poses[i - 1].t_s) + "); timestamps must increase");
+    if (!std::isfinite(poses[i].t_s)) {
+      throw std::invalid_argument("associate: " + std::string(name) + "[" + std::to_string(i) +
+                                  "] has a non-finite timestamp");
     }
   }
 }
+
+// The index of the pose nearest in time to t, the first in file order among equally near ones:
+// numpy's argmin over |t_i - t|, which evo takes, in O(log n) per query (plus the ties).
+class NearestTime {
+ public:
+  explicit NearestTime(const std::vector<StampedPose>& poses) : order_(poses.size()) {
+    for (std::size_t i = 0; i < order_.size(); ++i) order_[i] = static_cast<int>(i);
+    // Stable: equal timestamps keep their file order.
+    std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) {
+      return poses[static_cast<std::size_t>(a)].t_s < poses[static_cast<std::size_t>(b)].t_s;
+    });
+    times_.reserve(order_.size());
+    for (int i : order_) times_.push_back(poses[static_cast<std::size_t>(i)].t_s);
+  }
+
+  // -1 when there are no poses.
+  int operator()(double t) const {
+    if (times_.empty()) return -1;
+    const auto n = static_cast<std::ptrdiff_t>(times_.size());
+    const std::ptrdiff_t after = std::lower_bound(times_.begin(), times_.end(), t) - times_.begin();
+    double best = std::numeric_limits<double>::infinity();
+    if (after < n) best = std::abs(times_[static_cast<std::size_t>(after)] - t);
+    if (after > 0) best = std::min(best, std::abs(times_[static_cast<std::size_t>(after - 1)] - t));
+    // |t_i - t| only grows away from t on either side (as computed, too), so every pose at the
+    // smallest difference is next to `after`: take the first of them in file order.
+    int first = std::numeric_limits<int>::max();
+    for (std::ptrdiff_t k = after; k < n && std::abs(times_[static_cast<std::size_t>(k)] - t) == best; ++k) {
+      first = std::min(first, order_[static_cast<std::size_t>(k)]);
+    }
+    for (std::ptrdiff_t k = after - 1; k >= 0 && std::abs(times_[static_cast<std::size_t>(k)] - t) == best; --k) {
+      first = std::min(first, order_[static_cast<std::size_t>(k)]);
+    }
+    return first;
+  }
+
+ private:
+  std::vector<int> order_;     // pose indices by time, ties in file order
+  std::vector<double> times_;  // their timestamps
+};
 
 Eigen::Isometry3d translationOnly(const Eigen::Vector3d& t) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -146,21 +183,28 @@ std::vector<PosePair> associate(const std::vector<StampedPose>& est, const std::
   }
   checkTimes(est, "est");
   checkTimes(gt, "gt");
+  // evo: the estimate is the shorter unless it has strictly more poses.
+  const bool est_longer = est.size() > gt.size();
+  const std::vector<StampedPose>& shorter = est_longer ? gt : est;
+  const std::vector<StampedPose>& longer = est_longer ? est : gt;
+  const NearestTime nearest(longer);
   std::vector<PosePair> pairs;
-  for (const StampedPose& e : est) {
-    // First gt at or after e; the nearest is it or the one before (a tie goes to the earlier).
-    const auto after =
-        std::lower_bound(gt.begin(), gt.end(), e.t_s, [](const StampedPose& g, double t) { return g.t_s < t; });
-    auto best = gt.end();
-    if (after != gt.end()) best = after;
-    if (after != gt.begin()) {
-      const auto before = std::prev(after);
-      if (best == gt.end() || e.t_s - before->t_s <= best->t_s - e.t_s) best = before;
-    }
-    if (best == gt.end() || std::abs(best->t_s - e.t_s) > max_dt_s) continue;
-    pairs.push_back(PosePair{e.t_s, e.X_WC, best->X_WC});
+  for (const StampedPose& s : shorter) {
+    const int j = nearest(s.t_s);
+    if (j < 0) break;
+    const StampedPose& l = longer[static_cast<std::size_t>(j)];
+    if (!(std::abs(l.t_s - s.t_s) <= max_dt_s)) continue;
+    const StampedPose& e = est_longer ? l : s;
+    const StampedPose& g = est_longer ? s : l;
+    pairs.push_back(PosePair{e.t_s, e.X_WC, g.X_WC});
   }
   return pairs;
+}
+
+int nonIncreasingTimes(const std::vector<StampedPose>& poses) {
+  int n = 0;
+  for (std::size_t i = 1; i < poses.size(); ++i) n += poses[i].t_s > poses[i - 1].t_s ? 0 : 1;
+  return n;
 }
 
 Eigen::Isometry3d umeyamaAlignment(const std::vector<Eigen::Vector3d>& est, const std::vector<Eigen::Vector3d>& gt) {

@@ -34,14 +34,20 @@ struct PosePair {
   Eigen::Isometry3d X_WC_gt = Eigen::Isometry3d::Identity();
 };
 
-// For each estimate, the ground-truth pose nearest in time within max_dt_s (estimates without
-// one are skipped); time order. std::invalid_argument for non-finite or non-increasing times.
-// Notes: t_s is the estimate's time; an exact tie between two ground-truth poses goes to the
-// earlier; a ground-truth pose may serve several estimates (when they are denser than it). The
-// error message names the sequence and index ("associate: gt[12] ..."); a negative or non-finite
-// max_dt_s is std::invalid_argument too.
+// Pairs by time as evo does (evo.core.sync.associate_trajectories): each pose of the shorter
+// trajectory (the estimate when both are as long) with the pose of the other whose timestamp is
+// nearest, if within max_dt_s; of poses equally near, the first in its file (numpy's argmin over
+// |t_i - t|). Timestamps need not increase or differ (TUM's own ground truth repeats some): each
+// file is taken in its own order. Pairs come in the shorter trajectory's order; t_s is the
+// estimate's time; one pose of the longer may serve several. std::invalid_argument for a
+// non-finite timestamp, naming the sequence and index ("associate: gt[12] ..."), and for a
+// negative or non-finite max_dt_s.
 std::vector<PosePair> associate(const std::vector<StampedPose>& est, const std::vector<StampedPose>& gt,
                                 double max_dt_s = 0.02);
+
+// The poses whose timestamp is not after the one before them in the file (repeated or going
+// back): 0 for strictly increasing times. Readers warn with it; associate() does not need order.
+int nonIncreasingTimes(const std::vector<StampedPose>& poses);
 
 // The rigid transform T (rotation and translation, no scale) minimising sum |T est_i - gt_i|^2
 // (Umeyama 1991). At least 3 non-collinear points for a unique rotation; with fewer, or

@@ -25,15 +25,6 @@ Eigen::Matrix3d nearestRotation(const Eigen::Matrix3d& R, int line_no) {
   return svd.matrixU() * svd.matrixV().transpose();
 }
 
-void checkIncreasing(const std::vector<StampedPose>& poses, const std::vector<int>& lines) {
-  for (std::size_t i = 1; i < poses.size(); ++i) {
-    if (!(poses[i].t_s > poses[i - 1].t_s)) {
-      text::fail(lines[i], "timestamp " + text::str(poses[i].t_s) + " is not after " + text::str(poses[i - 1].t_s) +
-                               " on line " + std::to_string(lines[i - 1]) + "; timestamps must increase");
-    }
-  }
-}
-
 }  // namespace
 
 TrajectoryFormat parseTrajectoryFormat(const std::string& name) {
@@ -137,20 +128,18 @@ std::string toTrajectory(const std::vector<StampedPose>& poses, TrajectoryFormat
 }
 
 std::vector<StampedPose> parseTrajectory(const std::string& content, TrajectoryFormat format) {
-  std::vector<int> lines;
   std::vector<StampedPose> poses;
   switch (format) {
     case TrajectoryFormat::kTum:
-      poses = parseTum(content, &lines);
+      poses = parseTum(content);
       break;
     case TrajectoryFormat::kKitti:
-      poses = parseKitti(content, &lines);
+      poses = parseKitti(content);
       break;
     case TrajectoryFormat::kEuroc:
-      poses = parseEuroc(content, &lines);
+      poses = parseEuroc(content);
       break;
   }
-  checkIncreasing(poses, lines);
   return poses;
 }
 

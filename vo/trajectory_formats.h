@@ -38,9 +38,8 @@ std::string toEuroc(const std::vector<StampedPose>& poses);
 // At least 8 comma-separated numbers per line (those past the 8th are not read); t_s = ns / 1e9.
 std::vector<StampedPose> parseEuroc(const std::string& text, std::vector<int>* lines = nullptr);
 
-// The writer or reader of `format`. parseTrajectory also requires strictly increasing timestamps
-// ("line 7: timestamp 0.3 is not after 0.3 on line 6; timestamps must increase"), as evaluation
-// does; parseTum, parseKitti and parseEuroc leave the order alone.
+// The writer or reader of `format`. Timestamps are taken in the file's order, repeated or going
+// back included (associate() pairs them by evo's rule; nonIncreasingTimes() counts them).
 std::string toTrajectory(const std::vector<StampedPose>& poses, TrajectoryFormat format);
 std::vector<StampedPose> parseTrajectory(const std::string& text, TrajectoryFormat format);
 

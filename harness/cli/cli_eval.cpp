@@ -1,6 +1,7 @@
 // tgnav eval: ATE and RPE of any trajectory pair (TUM, KITTI, EuRoC) with evo's definitions
 // (harness/run/eval_run.h).
 #include <cstdio>
+#include <string>
 
 #include "harness/cli/cli.h"
 #include "harness/run/eval_run.h"
@@ -30,6 +31,7 @@ void addEvalCommand(CLI::App& app) {
   cmd->callback([job, figure_format] {
     job->figure_format = harness::parseFigureFormat(*figure_format);
     const harness::EvalResult r = harness::runEval(*job);
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "%s\n", w.c_str());
     harness::reportFigures("tgnav eval", r.figures);
     std::printf("%s\n", harness::evalSummaryLine(r).c_str());
   });

@@ -79,8 +79,9 @@ struct Sequence {
   std::vector<SequenceEntry> frames;  // in time order
   int unpaired_rgb = 0;               // listed images without a partner within kMaxPairDtS
   int unpaired_depth = 0;
-  std::vector<vo::StampedPose> groundtruth;  // empty when there is no groundtruth.txt
+  std::vector<vo::StampedPose> groundtruth;  // empty when there is no groundtruth.txt; in file order
   bool has_groundtruth = false;
+  int groundtruth_non_increasing = 0;              // its timestamps that repeat or go back (vo::nonIncreasingTimes)
   std::optional<vo::CameraIntrinsics> intrinsics;  // from intrinsics.yaml, when present
   double depth_scale = kTumDepthScale;             // intrinsics.yaml may override it
 };
@@ -92,9 +93,10 @@ std::string intrinsicsYaml(const vo::CameraIntrinsics& k, double depth_scale, co
 
 // Reads the lists, ground truth and intrinsics (not the images) of the sequence in `dir`.
 // InputError naming the file and line for: a missing folder, rgb.txt or depth.txt; malformed
-// or empty lists; timestamps that do not increase; listed image files that do not exist (of
+// or empty lists; list timestamps that do not increase; listed image files that do not exist (of
 // paired frames); no rgb/depth pair within kMaxPairDtS; a malformed groundtruth.txt or
-// intrinsics.yaml.
+// intrinsics.yaml. Ground-truth timestamps may repeat or go back (TUM's own files repeat some):
+// they are counted, and vo::associate() pairs them by evo's rule.
 Sequence loadSequence(const std::filesystem::path& dir);
 
 struct SequenceImages {

@@ -1,8 +1,12 @@
 #include "harness/run/eval_run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
@@ -71,8 +75,11 @@ std::vector<vo::StampedPose> readTrajectory(const fs::path& file, vo::Trajectory
   return poses;
 }
 
+// The earliest and latest timestamps (files need not be in time order).
 std::string timeSpan(const std::vector<vo::StampedPose>& poses) {
-  return "t " + str(poses.front().t_s) + " .. " + str(poses.back().t_s) + " s";
+  const auto [first, last] = std::minmax_element(
+      poses.begin(), poses.end(), [](const vo::StampedPose& a, const vo::StampedPose& b) { return a.t_s < b.t_s; });
+  return "t " + str(first->t_s) + " .. " + str(last->t_s) + " s";
 }
 
 // Pairs by time, or by line for KITTI (whose timestamps are the line indices).
@@ -114,6 +121,8 @@ nlohmann::ordered_json summaryJson(const EvalJob& job, const Settings& s, const 
   if (s.format != vo::TrajectoryFormat::kKitti) j["max_dt_s"] = job.max_dt_s;
   j["ref_poses"] = ref.size();
   j["est_poses"] = est.size();
+  j["ref_non_increasing"] = vo::nonIncreasingTimes(ref);
+  j["est_non_increasing"] = vo::nonIncreasingTimes(est);
   j["pairs"] = a.n;
   j["alignment"] = alignmentJson(ape.alignment);
   j["ate"] = {{"rmse_m", a.rmse}, {"mean_m", a.mean}, {"median_m", a.median}, {"std_m", a.std},
@@ -156,6 +165,15 @@ EvalResult runEval(const EvalJob& job) {
   if (!job.out.empty()) result.out = newOutputDir(job.out, "tgnav eval");
   const std::vector<vo::StampedPose> ref = readTrajectory(job.ref, settings.format);
   const std::vector<vo::StampedPose> est = readTrajectory(job.est, settings.format);
+  for (const auto& [file, poses] : {std::pair{&job.ref, &ref}, std::pair{&job.est, &est}}) {
+    const int n = vo::nonIncreasingTimes(*poses);
+    if (n > 0 && settings.format != vo::TrajectoryFormat::kKitti) {
+      result.warnings.push_back(
+          "tgnav eval: warning: " + file->string() + ": " + std::to_string(n) +
+          " of its timestamps repeat or go back; poses are paired by evo's rule (nearest in time, "
+          "ties to the first in the file)");
+    }
+  }
   const std::vector<vo::PosePair> pairs = associated(job, settings.format, ref, est);
   const vo::ApeResult ape = vo::absolutePoseError(pairs, settings.align);
   // RPE of the aligned estimate: a rigid alignment leaves it unchanged, sim3's scale does not.

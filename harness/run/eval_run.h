@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "harness/io/figures.h"
 
@@ -33,14 +34,16 @@ struct EvalResult {
   std::filesystem::path out;       // the folder written; empty when none was asked for
   FigureFormat figure_format = FigureFormat::kPng;
   FigureOutcome figures;
+  std::vector<std::string> warnings;  // lines for stderr: timestamps that repeat or go back
 };
 
 // InputError, one line naming the option, or the file and line, for: an unknown --format,
 // --align or --rpe-unit; a --rpe-delta that is not > 0 (a whole number of frames for frames); a
 // negative --max-dt; an --out that exists; a missing file, an empty one, a malformed line (wrong
 // count of numbers: a file of another format; non-finite values; a non-unit quaternion; a KITTI
-// rotation that is not one), timestamps that do not increase; KITTI files of different lengths;
-// no estimate within --max-dt of a reference pose. Nothing is written then.
+// rotation that is not one); KITTI files of different lengths; no pair within --max-dt. Nothing is
+// written then. Timestamps that repeat or go back are paired by evo's rule (vo::associate), with a
+// warning that counts them.
 EvalResult runEval(const EvalJob& job);
 
 // The one line `tgnav eval` prints.

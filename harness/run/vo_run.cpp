@@ -27,6 +27,14 @@ constexpr double kRpeDeltaM = 1.0;
 
 // Ground truth at time t: interpolated inside its span (linear position, slerp rotation), the
 // end pose within kMaxPairDtS outside it; nothing otherwise.
+std::string nonIncreasingWarning(const Sequence& seq) {
+  return "tgnav vo: warning: " + (seq.dir / "groundtruth.txt").string() + ": " +
+         std::to_string(seq.groundtruth_non_increasing) +
+         " of its timestamps repeat or go back; poses are paired by evo's rule (nearest in time, ties to the first in "
+         "the file)";
+}
+
+// `gt` in time order (ties in any order).
 bool groundtruthAt(const std::vector<vo::StampedPose>& gt, double t, Eigen::Isometry3d* X_WC) {
   if (gt.empty()) return false;
   if (t <= gt.front().t_s || t >= gt.back().t_s) {
@@ -201,6 +209,7 @@ nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const 
   j["reinitialisations"] = t.reinitialisations;
   j["unpaired_rgb"] = seq.unpaired_rgb;
   j["unpaired_depth"] = seq.unpaired_depth;
+  j["groundtruth_non_increasing"] = seq.groundtruth_non_increasing;
   j["intrinsics"] = {{"source", camera.source},
                      {"width", k.width_px},
                      {"height", k.height_px},
@@ -236,9 +245,13 @@ VoRunResult runVo(const VoJob& job) {
   if (job.reinitialise) config.reinitialise_after_lost = true;
 
   Sequence seq = loadSequence(job.sequence);
+  if (seq.groundtruth_non_increasing > 0) std::fprintf(stderr, "%s\n", nonIncreasingWarning(seq).c_str());
   const Camera camera = sequenceCamera(&seq, job.intrinsics);
   Eigen::Isometry3d X_WC0 = Eigen::Isometry3d::Identity();
-  const bool start_from_gt = groundtruthAt(seq.groundtruth, seq.frames.front().t_s, &X_WC0);
+  std::vector<vo::StampedPose> by_time = seq.groundtruth;
+  std::stable_sort(by_time.begin(), by_time.end(),
+                   [](const vo::StampedPose& a, const vo::StampedPose& b) { return a.t_s < b.t_s; });
+  const bool start_from_gt = groundtruthAt(by_time, seq.frames.front().t_s, &X_WC0);
   vo::RgbdOdometry odometry(camera.intrinsics, config, X_WC0);
   const Tracking tracking = trackSequence(seq, camera.intrinsics, &odometry, job.progress);
 

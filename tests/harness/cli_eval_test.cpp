@@ -167,6 +167,36 @@ TEST(CliEval, EurocNanosecondFiles) {
   EXPECT_NEAR(j["ate"]["rmse_m"].get<double>(), 0.2, 1e-9);
 }
 
+// TUM's own ground truth repeats timestamps (fr2/desk); estimates may be written out of order. evo
+// pairs each pose of the shorter file with the nearest in time of the other, ties to the first in
+// the file. Here the reference repeats 0.1 with two positions, 1.0 then 1.5; the estimate has 1.2
+// there and the reference's positions elsewhere: paired with the first, the errors are
+// 0, 0.2, 0, 0 m (rmse 0.1, mean 0.05); with the second they would be 0, 0.3, 0, 0.
+TEST(CliEval, RepeatedAndUnorderedTimestampsArePairedByEvosRule) {
+  const fs::path dir = test::tempDir();
+  const fs::path ref = test::writeFile(
+      dir / "gt.tum",
+      "0 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n0.1 1.5 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n0.3 3 0 0 0 0 0 1\n");
+  const fs::path est =
+      test::writeFile(dir / "est.tum", "0 0 0 0 0 0 0 1\n0.2 2 0 0 0 0 0 1\n0.1 1.2 0 0 0 0 0 1\n0.3 3 0 0 0 0 0 1\n");
+  const fs::path out = dir / "out";
+  const CmdResult run =
+      tgnav("eval --ref " + ref.string() + " --est " + est.string() + " --align none --out " + out.string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find("tgnav eval: warning: " + ref.string() + ": 1 of its timestamps repeat or go back"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("tgnav eval: warning: " + est.string() + ": 1 of its timestamps"), std::string::npos)
+      << run.output;
+  const nlohmann::json j = readJson(out / "eval.json");
+  EXPECT_EQ(j["pairs"], 4);
+  EXPECT_EQ(j["ref_non_increasing"], 1);
+  EXPECT_EQ(j["est_non_increasing"], 1);
+  EXPECT_NEAR(j["ate"]["rmse_m"].get<double>(), 0.1, 1e-12);
+  EXPECT_NEAR(j["ate"]["mean_m"].get<double>(), 0.05, 1e-12);
+  EXPECT_NEAR(j["ate"]["max_m"].get<double>(), 0.2, 1e-12);
+}
+
 TEST(CliEval, BadInputIsOneLineExit2AndWritesNothing) {
   const fs::path dir = test::tempDir();
   const std::string ref = test::writeFile(dir / "gt.tum", tumFile(0.01, Eigen::Vector3d::Zero())).string();
@@ -174,10 +204,6 @@ TEST(CliEval, BadInputIsOneLineExit2AndWritesNothing) {
   const std::string kitti = test::writeFile(dir / "00.txt", kittiFile(10, 1.0)).string();
   const std::string kitti9 = test::writeFile(dir / "09.txt", kittiFile(9, 1.0)).string();
   const std::string empty = test::writeFile(dir / "empty.tum", "# no poses\n").string();
-  const std::string dup =
-      test::writeFile(dir / "dup.tum", "0 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n").string();
-  const std::string back =
-      test::writeFile(dir / "back.tum", "0 0 0 0 0 0 0 1\n0.2 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n").string();
   const std::string nan = test::writeFile(dir / "nan.tum", "0 0 0 0 0 0 0 1\n0.1 0 nan 0 0 0 0 1\n").string();
   const std::string late = test::writeFile(dir / "late.tum", tumFile(0.05, Eigen::Vector3d::Zero(), 100.0)).string();
   const std::string tilted = test::writeFile(dir / "tilted.txt", "1 0 0 0 0 1 0 0 0 0.1 1 0\n").string();
@@ -191,8 +217,6 @@ TEST(CliEval, BadInputIsOneLineExit2AndWritesNothing) {
       {" --ref " + (dir / "missing.tum").string() + " --est " + est, (dir / "missing.tum").string() + ": cannot read"},
       {" --ref " + ref + " --est " + empty, empty + ": no poses (an empty trajectory)"},
       {" --ref " + ref + " --est " + dir.string(), dir.string() + ": cannot read: it is a directory"},
-      {" --ref " + ref + " --est " + dup, dup + ":3: timestamp 0.1 is not after 0.1 on line 2"},
-      {" --ref " + back + " --est " + est, back + ":3: timestamp 0.1 is not after 0.2 on line 2"},
       {" --ref " + ref + " --est " + late, late + ": no pose within --max-dt 0.02 s of a pose of " + ref +
                                                " (estimate t 100 .. 104 s, reference t 0 .. 4 s)"},
       {" --ref " + ref + " --est " + kitti,
