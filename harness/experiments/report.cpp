@@ -14,6 +14,7 @@
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
 #include "harness/experiments/report_trial.h"
+#include "harness/experiments/statistics.h"
 #include "harness/experiments/sweep.h"
 #include "harness/io/staged_output.h"
 
@@ -429,7 +430,7 @@ std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std:
     const bool first_of_scene = i == 0 || rows[i - 1].scene != t.scene;
     cells.push_back({first_of_scene ? "*" + markdownCell(t.scene) + "*" : "", markdownCell(t.label),
                      std::to_string(t.trials), formatSummary(t.length_m), formatSummary(t.goal_error_m),
-                     std::to_string(t.successes) + "/" + std::to_string(t.trials),
+                     formatSuccessInterval(t.successes, t.trials),
                      std::to_string(t.drifted) + "/" + std::to_string(t.trials), formatSummary(t.plan_time_s),
                      formatSummary(t.ate_rmse_m), formatOutcomes(t.outcomes)});
   }
@@ -445,7 +446,8 @@ std::string table2Markdown(const std::vector<TableRow>& rows, int finished, std:
          "path, trials that flew. *Goal error: |estimated − true| final position, over the trials whose VO "
          "tracked to the goal (success and drifted; the paper's Table II: its successful trials). VO success: "
          "trials whose VO tracked all the way to the goal and ended within trial.max_drift_ratio of the distance "
-         "flown. Drifted: trials whose VO tracked to the goal but ended further off. ATE RMSE: trials with tracked "
+         "flown, with its 95 % Wilson interval. Drifted: trials whose VO tracked to the goal but ended further off. "
+         "ATE RMSE: trials with tracked "
          "frames.\n";
   return out.str();
 }

@@ -7,6 +7,7 @@
 #include "harness/config/scenario.h"
 #include "harness/experiments/report_scenes.h"
 #include "harness/experiments/report_trial.h"
+#include "harness/experiments/statistics.h"
 #include "harness/io/staged_output.h"
 #include "harness/io/topdown.h"
 #include "harness/run/map_cache.h"
@@ -177,6 +178,8 @@ ReportRunResult runReport(const ReportJob& job) {
   const std::vector<SceneReport> scenes = sceneReports(sweep.rows);
   const std::vector<AggregateRow> aggregate = aggregateRows(sweep.rows, scenes);
   r.markdown += generalisationMarkdown(scenes, aggregate, per_scene);
+  const std::vector<PairedComparison> comparisons = pairedComparisons(sweep.rows, groups);
+  r.markdown += comparisonsMarkdown(comparisons);
   if (!job.no_plots) r.markdown += figureNotes(sweep);
   makeOutputDir(r.out);
   writeFileAtomic(r.out / "table2.csv", table2Csv(table));
@@ -186,6 +189,7 @@ ReportRunResult runReport(const ReportJob& job) {
     fs::remove(r.out / "scenes.csv", ec);  // from an earlier report of this folder
   }
   writeFileAtomic(r.out / "aggregate.csv", aggregateCsv(aggregate));
+  writeFileAtomic(r.out / "comparisons.csv", comparisonsCsv(comparisons));
   writeFileAtomic(r.out / "table2.md", r.markdown);
   if (!job.no_plots) r.figures_failed = reportFigures(sweep, groups, table, r.out, job);
   return r;

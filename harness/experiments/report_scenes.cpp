@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include "harness/experiments/statistics.h"
+
 namespace tgnav::harness {
 namespace {
 
@@ -228,7 +230,9 @@ std::vector<AggregateRow> aggregateRows(const std::vector<IndexRow>& rows, const
 
 std::string formatShare(int k, int n) {
   if (n == 0) return "n/a";
-  return std::to_string(k) + "/" + std::to_string(n) + " (" + percent(k, n) + ")";
+  const Interval w = wilsonInterval(k, n);
+  return std::to_string(k) + "/" + std::to_string(n) + " (" + percent(k, n) + "; " +
+         std::to_string(std::lround(100.0 * w.lo)) + "–" + std::to_string(std::lround(100.0 * w.hi)) + "%)";
 }
 
 std::string scenesCsv(const std::vector<SceneReport>& scenes) {

@@ -79,7 +79,7 @@ struct AggregateRow {
 // Planner groups in order of first appearance, then the oracle row when there are oracle trials.
 std::vector<AggregateRow> aggregateRows(const std::vector<IndexRow>& rows, const std::vector<SceneReport>& scenes);
 
-// "k/n (p%)", or "n/a" for n = 0.
+// "k/n (p%; lo–hi%)" with the 95 % Wilson interval (statistics.h), or "n/a" for n = 0.
 std::string formatShare(int k, int n);
 
 std::string scenesCsv(const std::vector<SceneReport>& scenes);

@@ -138,7 +138,7 @@ TEST(ReportScenes, FlyableIsTwoThirdsOfTheOracleTrials) {
   EXPECT_FALSE(isFlyable(3, 5));
   EXPECT_TRUE(isFlyable(1, 1));
   EXPECT_FALSE(isFlyable(0, 0));
-  EXPECT_EQ(formatShare(2, 3), "2/3 (67%)");
+  EXPECT_EQ(formatShare(2, 3), "2/3 (67%; 21–94%)");  // Wilson: scipy binomtest(2, 3).proportion_ci(method="wilson")
   EXPECT_EQ(formatShare(0, 0), "n/a");
 }
 
@@ -252,7 +252,7 @@ TEST(ReportScenes, WithoutOracleTrialsSelectionIsNotApplicable) {
   const std::string md = generalisationMarkdown(scenes, rows, false);
   EXPECT_EQ(md.find("## Per scene"), std::string::npos);
   EXPECT_NE(md.find("| Proposed |      2 |                      0 of 1 |              n/a |                n/a |"
-                    "                    1/1 (100%) |"),
+                    "           1/1 (100%; 21–100%) |"),
             std::string::npos)
       << md;
 }
@@ -277,8 +277,8 @@ TEST(ReportScenes, RunReportWritesTheTablesAndTheMarkdownSections) {
             std::string::npos);
   EXPECT_NE(md.find("|         |     2 |        2/3 |    2.00 | no                | yes     |"), std::string::npos)
       << md;
-  EXPECT_NE(md.find("| Proposed             |      5 |                      1 of 3 |        2/3 (67%) |"
-                    "          2/3 (67%) |                     3/4 (75%) |"),
+  EXPECT_NE(md.find("| Proposed             |      5 |                      1 of 3 | 2/3 (67%; 21–94%) |"
+                    "  2/3 (67%; 21–94%) |             3/4 (75%; 30–95%) |"),
             std::string::npos)
       << md;
   EXPECT_NE(md.find("1 of 3 scene(s) have a flyable class"), std::string::npos);

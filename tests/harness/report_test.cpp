@@ -242,20 +242,21 @@ TEST(ReportAggregation, MarkdownLayoutFollowsTableTwo) {
   EXPECT_EQ(lines[2], "4 of 5 trials finished.");
   // Header, alignment row, one row per group, the scene named once per block.
   EXPECT_EQ(lines[4],
-            "| Scene     | Planner  | Trials | Length (m) | Goal error (m)* | VO success | Drifted | Plan time (s) |"
+            "| Scene     | Planner  | Trials | Length (m) | Goal error (m)* |    VO success | Drifted | Plan time (s) |"
             "    ATE RMSE (m) | Outcomes  |");
   EXPECT_EQ(lines[5],
-            "| --------- | -------- | -----: | ---------: | --------------: | ---------: | ------: | ------------: |"
+            "| --------- | -------- | -----: | ---------: | --------------: | ------------: | ------: | ------------: |"
             " --------------: | --------- |");
   EXPECT_EQ(lines[6],
-            "| *storage* | Proposed |      2 | 16.0 ± 0.1 |   0.118 ± 0.025 |        2/2 |     0/2 |   1.60 ± 0.14 |"
+            "| *storage* | Proposed |      2 | 16.0 ± 0.1 |   0.118 ± 0.025 | 2/2 (34–100%) |     0/2 |   1.60 ± 0.14 |"
             " 0.0300 ± 0.0141 | 2 success |");
-  // One trial: the mean alone, to 3 significant figures; no goal error without a success.
+  // One trial: the mean alone, to 3 significant figures; no goal error without a success. VO
+  // success with its 95 % Wilson interval (scipy: 2/2 0.342-1, 0/1 0-0.793, 1/1 0.207-1).
   EXPECT_EQ(lines[7],
-            "|           | AP       |      1 |       10.0 |               – |        0/1 |     0/1 |          1.00 |"
+            "|           | AP       |      1 |       10.0 |               – |   0/1 (0–79%) |     0/1 |          1.00 |"
             "          0.0500 | 1 vo_lost |");
   EXPECT_EQ(lines[8],
-            "| *gallery* | R-15000  |      1 |       10.0 |           0.100 |        1/1 |     0/1 |           164 |"
+            "| *gallery* | R-15000  |      1 |       10.0 |           0.100 | 1/1 (21–100%) |     0/1 |           164 |"
             "          0.0500 | 1 success |");
   EXPECT_NE(lines[10].find("over the trials whose VO tracked to the goal (success and drifted"), std::string::npos);
 }
