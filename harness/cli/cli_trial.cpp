@@ -103,6 +103,12 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_option("--map-cache", job.map_cache,
                   "Cache folder for feature maps (default: $TGNAV_CACHE_DIR or ~/.cache/tgnav)");
   auto homology_class = std::make_shared<int>(0);
+  cmd->add_option("--trajectory", job.trajectory,
+                  "Fly this setpoint CSV (t,x,y,z,yaw[,vx,vy,vz,ax,ay,az][,yaw_rate], as `tgnav fly`) instead of "
+                  "planning; checked against the map first");
+  cmd->add_option("--path", job.path,
+                  "Smooth this 4-DoF path CSV (x,y,z,yaw) with the trajectory generator and fly it instead of "
+                  "planning; checked against the map first");
   cmd->add_option("--class", *homology_class,
                   "The oracle: fly homology class K of plan.json's classes (proposed: its pose-graph path; "
                   "agnostic: its shortest path); not with rrtstar");
@@ -110,6 +116,11 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_flag("--no-figures", opt->no_figures, "Write the data only (a sweep's report draws the figures)");
   cmd->callback([opt, cmd, homology_class] {
     if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
+    for (const char* given : {"--trajectory", "--path"}) {
+      if (cmd->count(given) > 0 && cmd->count("--planner") > 0) {
+        throw InputError(std::string(given) + ": flies what it is given; --planner is for planning one");
+      }
+    }
     const int rc = runTrialCommand(*opt);
     if (rc != 0) throw CLI::RuntimeError(rc);
   });

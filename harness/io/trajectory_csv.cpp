@@ -35,6 +35,61 @@ std::vector<std::string> splitCsv(const std::string& line) {
 
 }  // namespace
 
+std::vector<planner::Pose4> readPathCsv(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string() + ": cannot open path file");
+  const std::string name = file.string();
+  auto fail = [&](int line, const std::string& what) {
+    throw InputError(name + ":" + std::to_string(line) + ": " + what);
+  };
+  std::map<std::string, int> col;
+  std::vector<planner::Pose4> path;
+  std::string raw;
+  int line_no = 0;
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const std::string line = trim(raw);
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> fields = splitCsv(line);
+    if (col.empty()) {
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        if (fields[i] != "x" && fields[i] != "y" && fields[i] != "z" && fields[i] != "yaw") {
+          fail(line_no, "unknown column '" + fields[i] + "' (a path has the columns x,y,z,yaw)");
+        }
+        if (!col.emplace(fields[i], static_cast<int>(i)).second) {
+          fail(line_no, "column '" + fields[i] + "' appears twice");
+        }
+      }
+      for (const char* c : {"x", "y", "z", "yaw"}) {
+        if (!col.count(c)) fail(line_no, std::string("missing required column '") + c + "'");
+      }
+      continue;
+    }
+    if (fields.size() != col.size()) {
+      fail(line_no,
+           "row has " + std::to_string(fields.size()) + " fields, the header has " + std::to_string(col.size()));
+    }
+    auto value = [&](const char* c) {
+      const std::string& text = fields[static_cast<std::size_t>(col.at(c))];
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
+        fail(line_no, std::string("column '") + c + "' has value '" + text + "', expected a finite number");
+      }
+      return v;
+    };
+    planner::Pose4 p;
+    p.p_WB = Eigen::Vector3d(value("x"), value("y"), value("z"));
+    p.yaw_rad = value("yaw");
+    path.push_back(p);
+  }
+  if (col.empty()) throw InputError(name + ": empty path file (no header row)");
+  if (path.size() < 2) {
+    throw InputError(name + ": a path needs at least 2 waypoints, this one has " + std::to_string(path.size()));
+  }
+  return path;
+}
+
 control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw InputError(file.string() + ": cannot open trajectory file");

@@ -80,19 +80,28 @@ void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario) {
   scenario->planner.oracle_class = k;
 }
 
+ClearanceBand clearanceBand(const Scenario& scenario) {
+  // Collision checks happen within the pose graph's samples around the flight height.
+  const double z = scenario.scene.start.p_WB.z();
+  const double reach = scenario.planner.perception.graph.sample_radius_m + scenario.planner.perception.robot_radius_m;
+  return {z - reach - 0.2, z + reach + 0.2};
+}
+
+std::unique_ptr<planner::VoxelMap> planningVoxels(const Scenario& scenario, const planner::FeatureMap& map) {
+  const SceneConfig& scene = scenario.scene;
+  const ClearanceBand band = clearanceBand(scenario);
+  return std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
+                                             scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m), band.lo_m,
+                                             band.hi_m);
+}
+
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
                    std::uint64_t seed, int rrt_samples, const std::string& oracle_option) {
   PlanRun run;
   run.planner = kind;
   run.seed = seed;
-  const SceneConfig& scene = scenario.scene;
   auto t0 = std::chrono::steady_clock::now();
-  // Collision checks happen within the pose graph's samples around the flight height.
-  const double z = scene.start.p_WB.z();
-  const double reach = scenario.planner.perception.graph.sample_radius_m + scenario.planner.perception.robot_radius_m;
-  run.voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                   scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                   z - reach - 0.2, z + reach + 0.2);
+  run.voxels = planningVoxels(scenario, map);
   run.voxel_map_s = since(t0);
 
   planner::RrtStarConfig rrt = scenario.planner.rrt_star;
@@ -111,7 +120,7 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
                      ": the rrtstar planner has no homology class to fly; use proposed or agnostic");
   }
   const auto solver = planner::makePlanner(kind, *run.voxels, scenario.planner.perception, rrt);
-  planner::PlanRequest request{scene.start, scene.goal, seed};
+  planner::PlanRequest request{scenario.scene.start, scenario.scene.goal, seed};
   request.homology_class = oracle;
   t0 = std::chrono::steady_clock::now();
   run.plan = solver->solve(request);

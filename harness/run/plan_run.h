@@ -33,8 +33,18 @@ struct PlanRun {
   double trajectory_s = 0.0;  // wall time: trajectory generation
 };
 
-// Box of the dense voxel map: the scene's bounds widened by `margin_m` (walls lie just outside
-// the free-space bounds and must be inside the box to be seen and avoided).
+// The heights where the dense voxel map answers clearance: the flight height +- the pose graph's
+// sample radius, the robot radius and 0.2 m.
+struct ClearanceBand {
+  double lo_m = 0.0;
+  double hi_m = 0.0;
+};
+ClearanceBand clearanceBand(const Scenario& scenario);
+// The planners' dense voxel map of `map`: the scene's bounds widened by 0.5 m (walls lie just
+// outside the free-space bounds and must be inside the box to be seen and avoided), with the
+// distance field over clearanceBand().
+std::unique_ptr<planner::VoxelMap> planningVoxels(const Scenario& scenario, const planner::FeatureMap& map);
+
 // `--class K`: sets scenario->planner.oracle_class; InputError for K < 0 or with RRT*, which has
 // no homology classes to fly.
 void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario);

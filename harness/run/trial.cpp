@@ -12,6 +12,7 @@
 #include "control/state_estimator.h"
 #include "harness/base/errors.h"
 #include "harness/base/process.h"
+#include "harness/run/given_route.h"
 #include "harness/run/trial_metrics.h"
 #include "harness/run/vo_pipeline.h"
 #include "harness/sim/camera.h"
@@ -374,20 +375,49 @@ class ClosedLoop {
 TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
                      const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   TrialResult result;
-  result.plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples, options.oracle_option);
-  const planner::Plan& plan = result.plan.plan;
-  if (plan.chosen < 0 || !result.plan.trajectory.trajectory) {
-    result.status = TrialStatus::kPlanFailed;
-    result.detail = plan.chosen < 0 ? std::string("no path: ") + planner::toString(plan.status)
-                                    : "trajectory generation failed: " + result.plan.trajectory.reason;
-    return result;
+  if (options.given_trajectory || options.given_path) {
+    result.plan.planner = options.planner;
+    result.plan.seed = options.seed;
+    const auto t0 = std::chrono::steady_clock::now();
+    result.plan.voxels = planningVoxels(scenario, map);
+    result.plan.voxel_map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (options.given_trajectory) {
+      checkGivenTrajectory(scenario, *result.plan.voxels, *options.given_trajectory, options.given_file);
+      result.setpoints = options.given_trajectory;
+    } else {
+      checkGivenPath(scenario, *result.plan.voxels, *options.given_path, options.given_file);
+      // Smoothed as a plan's path is, without the homology check (a given path has no class).
+      result.plan.plan.path = *options.given_path;
+      planner::TrajectoryRequest request;
+      request.path = *options.given_path;
+      request.start_yaw_rad = scenario.scene.start.yaw_rad;
+      const auto t1 = std::chrono::steady_clock::now();
+      result.plan.trajectory = planner::generateTrajectory(request, planner::VoxelClearance(*result.plan.voxels),
+                                                           scenario.planner.trajectory);
+      result.plan.trajectory_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+      if (!result.plan.trajectory.trajectory) {
+        result.status = TrialStatus::kPlanFailed;
+        result.detail = "trajectory generation failed: " + result.plan.trajectory.reason;
+        return result;
+      }
+      result.setpoints = setpoints(result.plan, scenario.planner.trajectory.sample_rate_hz);
+    }
+  } else {
+    result.plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples, options.oracle_option);
+    const planner::Plan& plan = result.plan.plan;
+    if (plan.chosen < 0 || !result.plan.trajectory.trajectory) {
+      result.status = TrialStatus::kPlanFailed;
+      result.detail = plan.chosen < 0 ? std::string("no path: ") + planner::toString(plan.status)
+                                      : "trajectory generation failed: " + result.plan.trajectory.reason;
+      return result;
+    }
+    result.setpoints = setpoints(result.plan, scenario.planner.trajectory.sample_rate_hz);
   }
   if (interrupt != nullptr && interrupt->load()) {
     result.status = TrialStatus::kInterrupted;
     result.detail = "interrupted after planning";
     return result;
   }
-  result.setpoints = setpoints(result.plan, scenario.planner.trajectory.sample_rate_hz);
   ClosedLoop closed_loop(scenario, options, *result.setpoints, &result);
   TrialEvents events = closed_loop.fly(progress, interrupt);
   events.goal_error_m = trackedGoalError(result.frames);

@@ -37,6 +37,14 @@ struct TrialOptions {
   std::uint64_t seed = 0;
   int strip_frames = 0;                                // > 0: keep this many frames, evenly spread, for a frame strip
   std::string oracle_option = "planner.oracle_class";  // names the oracle class in errors
+  // A trajectory to fly instead of planning (`tgnav trial --trajectory FILE`; `given_file` names
+  // it in errors and results), checked against the map before the flight (given_route.h).
+  std::optional<control::SetpointTrajectory> given_trajectory;
+  // Or a 4-DoF path (`--path FILE`), checked the same way (waypoints and the lines between them),
+  // then smoothed by the trajectory generator under the scenario's limits.
+  std::optional<std::vector<planner::Pose4>> given_path;
+  std::string given_file;
+  bool given() const { return given_trajectory.has_value() || given_path.has_value(); }
 };
 
 struct TrialProgress {

@@ -32,6 +32,14 @@ void checkJob(const TrialJob& job) {
     throw InputError("--frames: " + std::to_string(job.frames) + " must be between 0 and 64");
   }
   if (job.threads < 0) throw InputError("--threads: " + std::to_string(job.threads) + " must be >= 1");
+  if (!job.trajectory.empty() && !job.path.empty()) {
+    throw InputError("--trajectory and --path: give one of them (or neither, to plan)");
+  }
+  const std::string given = !job.trajectory.empty() ? "--trajectory" : !job.path.empty() ? "--path" : "";
+  if (!given.empty() && (job.samples != 0 || job.homology_class)) {
+    throw InputError(given + ": flies what it is given; " + (job.samples != 0 ? "--samples" : "--class") +
+                     " is for a planner");
+  }
 }
 
 // --out must be new or empty unless --force.
@@ -95,9 +103,35 @@ std::string voCsv(const TrialResult& r) {
   return out.str();
 }
 
-void writeData(const fs::path& d, const Scenario& scenario, const TrialResult& r) {
-  writeFileAtomic(d / "config.yaml", runConfigYaml("trial", scenario, r.plan));
-  writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");
+void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
+  if (options.given()) {
+    const char* kind = options.given_path ? "path" : "trajectory";
+    writeFileAtomic(d / "config.yaml", std::string("# tgnav trial --") + kind + " " + options.given_file + " --seed " +
+                                           std::to_string(options.seed) + "\n" + resolvedScenarioYaml(scenario));
+    nlohmann::ordered_json plan;
+    plan["planner"] = kind;
+    plan["given_file"] = options.given_file;
+    plan["seed"] = options.seed;
+    plan["scenario"] = scenario.source.string();
+    plan["scene"] = scenario.scene.source.string();
+    if (options.given_path) {
+      plan["waypoints"] = options.given_path->size();
+      const planner::TrajectoryReport& tr = r.plan.trajectory;
+      plan["trajectory"] = {{"status", planner::toString(tr.status)},
+                            {"reason", tr.reason},
+                            {"duration_s", tr.duration_s},
+                            {"length_m", tr.length_m},
+                            {"min_clearance_m", tr.min_clearance_m}};
+    }
+    if (r.setpoints) {
+      plan["setpoints"] = r.setpoints->setpoints().size();
+      plan["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
+    }
+    writeFileAtomic(d / "plan.json", plan.dump(2) + "\n");
+  } else {
+    writeFileAtomic(d / "config.yaml", runConfigYaml("trial", scenario, r.plan));
+    writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");
+  }
   if (r.setpoints) writeFileAtomic(d / "trajectory.csv", trajectoryCsv(*r.setpoints));
   writeFileAtomic(d / "gt.tum", vo::toTum(cameraPoses(r.flight, r.X_BC)));
   std::vector<vo::StampedPose> est;
@@ -113,7 +147,9 @@ std::string summaryLine(const Scenario& scenario, const TrialOptions& options, c
                         const TrialScores& scores, const TrialTiming& timing, const fs::path& out) {
   std::ostringstream line;
   line.precision(3);
-  line << "tgnav trial: " << scenario.scene.source.stem().string() << ' ' << planner::toString(options.planner)
+  line << "tgnav trial: " << scenario.scene.source.stem().string() << ' '
+       << (options.given() ? std::string(options.given_path ? "path " : "trajectory ") + options.given_file
+                           : planner::toString(options.planner))
        << " seed " << options.seed << ": " << toString(r.status) << " (" << r.detail << ")";
   if (r.status != TrialStatus::kPlanFailed) {
     line << "; flown " << scores.path_length_m << " m, goal error "
@@ -134,7 +170,18 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   Scenario scenario = loadScenario(job.scenario, &overrides);
   if (job.seed) scenario.seed = *job.seed;
   if (job.threads > 0) limitThreads(job.threads, &scenario);
-  TrialOptions options{job.planner, job.samples, scenario.seed, job.frames};
+  TrialOptions options;
+  options.planner = job.planner;
+  options.rrt_samples = job.samples;
+  options.seed = scenario.seed;
+  options.strip_frames = job.frames;
+  if (!job.trajectory.empty()) {
+    options.given_trajectory = readTrajectoryCsv(job.trajectory);
+    options.given_file = job.trajectory.string();
+  } else if (!job.path.empty()) {
+    options.given_path = readPathCsv(job.path);
+    options.given_file = job.path.string();
+  }
   if (job.homology_class) {
     applyOracleClass(*job.homology_class, job.planner, &scenario);
     options.oracle_option = "--class";
@@ -155,7 +202,7 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   timing.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   const fs::path& d = staged.staging();
-  writeData(d, scenario, r);
+  writeData(d, scenario, options, r);
   writeMapLayer(d, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
   TrialJobResult result;
   if (r.status == TrialStatus::kInterrupted) {

@@ -30,7 +30,11 @@ struct TrialJob {
   std::string map_cache;
   int threads = 0;                    // > 0: at most this many threads (results do not change)
   std::optional<int> homology_class;  // the oracle: fly this class (planner.oracle_class)
-  bool figures = true;                // draw topdown and ate (a sweep leaves them to its report)
+  // Fly this setpoint CSV (the columns `tgnav fly` reads) instead of planning; "" = plan.
+  std::filesystem::path trajectory;
+  // Or smooth and fly this 4-DoF path CSV (x,y,z,yaw); "" = plan.
+  std::filesystem::path path;
+  bool figures = true;  // draw topdown and ate (a sweep leaves them to its report)
   FigureFormat figure_format = FigureFormat::kPng;
   // Called right before the trial (planning and flight) and right after it, before the results
   // are written: the CLI catches Ctrl-C only in between (a signal while the map is built or the

@@ -41,6 +41,17 @@ TrialScores scoreTrial(const TrialResult& result) {
   const planner::Plan& plan = result.plan.plan;
   if (plan.chosen >= 0) s.planned_length_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].length_m;
   s.trajectory_length_m = result.plan.trajectory.length_m;
+  if (plan.chosen < 0 && !plan.path.empty()) {  // a given path: its polyline, smoothed as planned
+    s.planned_length_m = 0.0;
+    for (std::size_t i = 1; i < plan.path.size(); ++i) {
+      s.planned_length_m += (plan.path[i].p_WB - plan.path[i - 1].p_WB).norm();
+    }
+  } else if (plan.chosen < 0 && result.setpoints) {  // a given trajectory: its setpoints' polyline
+    const std::vector<control::TrajectorySetpoint>& sp = result.setpoints->setpoints();
+    double length = 0.0;
+    for (std::size_t i = 1; i < sp.size(); ++i) length += (sp[i].p_WB - sp[i - 1].p_WB).norm();
+    s.planned_length_m = s.trajectory_length_m = length;
+  }
   s.path_length_m = flownLength(result.flight);
 
   std::vector<vo::PosePair> pairs;
@@ -83,9 +94,11 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   ordered_json j;
   j["scenario"] = scenario.source.string();
   j["scene"] = scenario.scene.source.stem().string();
-  j["planner"] = toString(options.planner);
-  j["samples"] =
-      options.planner == planner::PlannerKind::kRrtStar ? ordered_json(result.plan.rrt_samples) : ordered_json(nullptr);
+  const bool given = options.given();
+  j["planner"] = options.given_path ? "path" : given ? "trajectory" : toString(options.planner);
+  j["given_file"] = given ? ordered_json(options.given_file) : ordered_json(nullptr);
+  j["samples"] = options.planner == planner::PlannerKind::kRrtStar && !given ? ordered_json(result.plan.rrt_samples)
+                                                                             : ordered_json(nullptr);
   j["seed"] = options.seed;
   j["oracle_class"] =
       scenario.planner.oracle_class >= 0 ? ordered_json(scenario.planner.oracle_class) : ordered_json(nullptr);
@@ -113,14 +126,14 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
                                                    {"with", result.collision->what}}
                                     : ordered_json(nullptr);
   const planner::Plan& plan = result.plan.plan;
-  j["plan_status"] = planner::toString(plan.status);
+  j["plan_status"] = given ? "given" : planner::toString(plan.status);
   j["classes"] = result.plan.plan.topo.classes.size();
   j["chosen_class"] =
       result.plan.plan.chosen_class >= 0 ? ordered_json(result.plan.plan.chosen_class) : ordered_json(nullptr);
   j["c_p_min"] = plan.chosen >= 0 && std::isfinite(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
                      ? ordered_json(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
                      : ordered_json(nullptr);
-  j["trajectory_status"] = planner::toString(result.plan.trajectory.status);
+  j["trajectory_status"] = options.given_trajectory ? "given" : planner::toString(result.plan.trajectory.status);
   const TrackingSummary tracking = summarizeTracking(result.flight);
   j["tracking_rmse_m"] = tracking.position_rmse_m;
   j["vo_poses_fused"] = result.vo_fused;

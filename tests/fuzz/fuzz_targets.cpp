@@ -144,6 +144,13 @@ const std::vector<Entry>& entries() {
          write(file, t);
          harness::readTrajectoryCsv(file);
        }},
+      {{"path_csv", "a 4-DoF path CSV (tgnav trial --path)"},
+       harnessParser,
+       [](const std::string& t) {
+         const fs::path file = scratch().fresh() / "path.csv";
+         write(file, t);
+         harness::readPathCsv(file);
+       }},
       {{"movingai_map", "a MovingAI .map"},
        harnessParser,
        [](const std::string& t) {

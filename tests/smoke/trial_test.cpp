@@ -240,6 +240,120 @@ TEST(SmokeTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
   EXPECT_TRUE(std::filesystem::is_empty(dir));
 }
 
+// A planned trial's trajectory.csv flown again through --trajectory (same scenario and seed) is
+// the same trial: metrics.json equal but for wall-clock figures and the planner's own fields, and
+// the same frames, ground truth and estimate.
+TEST(SmokeTrialCli, GivenTrajectoryFliesAsThePlannedOne) {
+  const auto dir = tempDir();
+  ASSERT_EQ(shell(trialCommand("--seed 6" + kSmall + " --no-figures --out " + (dir / "planned").string())).rc, 0);
+  const std::string again =
+      trialCommand("--seed 6" + kSmall + " --no-figures --trajectory " + (dir / "planned/trajectory.csv").string() +
+                   " --out " + (dir / "given").string());
+  const CmdResult given = shell(again);
+  ASSERT_EQ(given.rc, 0) << given.output;
+  EXPECT_NE(given.output.find("smoke trajectory " + (dir / "planned/trajectory.csv").string() + " seed 6"),
+            std::string::npos)
+      << given.output;
+  auto comparable = [&](const char* run) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(readText(dir / run / "metrics.json"));
+    for (const char* key :
+         {"plan_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb", "timing", "planner", "given_file", "classes",
+          "chosen_class", "c_p_min", "plan_status", "planned_length_m", "trajectory_length_m", "trajectory_status"}) {
+      j.erase(key);
+    }
+    return j.dump(2);
+  };
+  EXPECT_EQ(comparable("planned"), comparable("given"));
+  for (const char* f : {"vo.csv", "gt.tum", "est.tum", "trajectory.csv"}) {
+    EXPECT_EQ(readText(dir / "planned" / f), readText(dir / "given" / f)) << f;
+  }
+  const nlohmann::json m = readJson(dir / "given/metrics.json");
+  EXPECT_EQ(m["planner"], "trajectory");
+  EXPECT_EQ(m["plan_status"], "given");
+  EXPECT_EQ(readJson(dir / "given/plan.json")["planner"], "trajectory");
+}
+
+// A 4-DoF path (--path) is smoothed by the trajectory generator under the scenario's limits and
+// flown as a plan would be; through the pillar it is refused before anything flies.
+TEST(SmokeTrialCli, GivenPathIsSmoothedAndFlown) {
+  const auto dir = tempDir();
+  const std::filesystem::path around = dir / "around.csv";
+  std::ofstream(around) << "x,y,z,yaw\n-3,0,1,0\n-1,-1.2,1,0\n1,-1.2,1,0\n3,0,1,0\n";
+  const CmdResult run = shell(trialCommand("--seed 2" + kSmall + " --no-figures --path " + around.string() + " --out " +
+                                           (dir / "around").string()));
+  ASSERT_EQ(run.rc, 0) << run.output;
+  const nlohmann::json m = readJson(dir / "around/metrics.json");
+  EXPECT_EQ(m["planner"], "path");
+  EXPECT_EQ(m["given_file"], around.string());
+  EXPECT_EQ(m["trajectory_status"], "optimised");
+  // Its polyline: 2 * sqrt(2^2 + 1.2^2) + 2 = 6.66 m; the smoothed trajectory cuts the corners.
+  EXPECT_NEAR(m["planned_length_m"].get<double>(), 2.0 * std::hypot(2.0, 1.2) + 2.0, 1e-9);
+  EXPECT_GT(m["trajectory_length_m"].get<double>(), 6.0);
+  EXPECT_LT(m["trajectory_length_m"].get<double>(), 6.67);
+  EXPECT_NE(m["status"], "plan_failed");
+  EXPECT_NE(m["status"], "collision");
+  EXPECT_EQ(readJson(dir / "around/plan.json")["trajectory"]["status"], "optimised");
+  // The flight went south of the pillar.
+  const std::string gt = readText(dir / "around/gt.tum");
+  EXPECT_FALSE(gt.empty());
+
+  const std::filesystem::path through = dir / "through.csv";
+  std::ofstream(through) << "x,y,z,yaw\n-3,0,1,0\n3,0,1,0\n";
+  const auto out = dir / "through";
+  const CmdResult refused = shell(trialCommand("--path " + through.string() + " --out " + out.string()));
+  EXPECT_EQ(refused.rc, 2) << refused.output;
+  EXPECT_EQ(lines(refused.output), 1) << refused.output;
+  EXPECT_NE(refused.output.find(through.string() + ": waypoint 2 at (3.00, 0.00, 1.00): the straight line from the "
+                                                   "one before passes closer than the robot radius"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const std::filesystem::path bad = dir / "bad.csv";
+  std::ofstream(bad) << "x,y,z\n-3,0,1\n";
+  const CmdResult header = shell(trialCommand("--path " + bad.string() + " --out " + out.string()));
+  EXPECT_EQ(header.rc, 2) << header.output;
+  EXPECT_NE(header.output.find(bad.string() + ":1: missing required column 'yaw'"), std::string::npos) << header.output;
+  const CmdResult both =
+      shell(trialCommand("--path " + bad.string() + " --trajectory " + bad.string() + " --out " + out.string()));
+  EXPECT_NE(both.output.find("--trajectory and --path: give one of them"), std::string::npos) << both.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// A given trajectory is checked against the map before anything flies: one line naming the file
+// and the first offending setpoint, exit 2, nothing written.
+TEST(SmokeTrialCli, GivenTrajectoryThroughAWallOrAwayFromTheStartIsRefused) {
+  const auto dir = tempDir();
+  auto write = [&](const std::string& name, const std::string& rows) {
+    const std::filesystem::path file = dir / name;
+    std::ofstream(file) << "t,x,y,z,yaw\n" << rows;
+    return file.string();
+  };
+  // The smoke scene: start (-3, 0, 1), goal (3, 0, 1), a pillar in between, bounds x +-4, y +-3.
+  const std::string through = write("through.csv", "0,-3,0,1,0\n10,3,0,1,0\n");
+  const std::string away = write("away.csv", "0,-2,0,1,0\n10,3,0,1,0\n");
+  const std::string outside = write("outside.csv", "0,-3,0,1,0\n5,-3,-2.5,1,0\n10,-3,-3.5,1,0\n");
+  const std::string nan = write("nan.csv", "0,-3,0,1,0\n10,nan,0,1,0\n");
+  const auto out = dir / "trial";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--trajectory " + through, through + ": setpoint 2 (t = 10 s) at (3.00, 0.00, 1.00): the straight line from "
+                                            "the one before passes closer than the robot radius"},
+      {"--trajectory " + away, away + ": setpoint 1 (t = 0 s) at (-2.00, 0.00, 1.00) is 1 m from the scenario's start"},
+      {"--trajectory " + outside, outside + ": setpoint 3 (t = 10 s) at (-3.00, -3.50, 1.00) is outside the scene's "
+                                            "bounds"},
+      {"--trajectory " + nan, nan + ":3: column 'x'"},
+      {"--trajectory " + (dir / "none.csv").string(), (dir / "none.csv").string()},
+      {"--trajectory " + through + " --planner agnostic", "--trajectory: flies what it is given; --planner"},
+      {"--trajectory " + through + " --class 1", "--trajectory: flies what it is given; --class"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const CmdResult run = shell(trialCommand(args + " --out " + out.string()));
+    EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
+    EXPECT_EQ(lines(run.output), 1) << args << "\n" << run.output;
+    EXPECT_NE(run.output.find(expected), std::string::npos) << args << "\n" << run.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << args;
+  }
+}
+
 // The oracle (--class K) flies class K instead of the planner's choice; a class that does not
 // exist, a negative one or one asked of RRT* is bad input: one line, exit 2, nothing written.
 TEST(SmokeTrialCli, OracleClassIsCheckedAndRecorded) {
