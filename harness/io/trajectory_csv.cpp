@@ -1,12 +1,16 @@
 #include "harness/io/trajectory_csv.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "harness/base/errors.h"
@@ -33,139 +37,146 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return out;
 }
 
+// A CSV file with a header row naming its columns ('#' comment lines and blank lines skipped).
+class HeaderedCsv {
+ public:
+  // `allowed` lists the columns, `columns_hint` says them in messages; the header must name every
+  // column of `required`, and passes `check` (which may fail()) when one is given.
+  HeaderedCsv(const std::filesystem::path& file, const char* what, std::vector<std::string> allowed,
+              std::vector<std::string> required, std::string columns_hint,
+              std::function<void(const HeaderedCsv&)> check = {})
+      : in_(file),
+        name_(file.string()),
+        allowed_(std::move(allowed)),
+        required_(std::move(required)),
+        hint_(std::move(columns_hint)),
+        check_(std::move(check)) {
+    if (!in_) throw InputError(name_ + ": cannot open " + what + " file");
+  }
+
+  // The next data row's fields (the header is read first, on the first call); false at the end.
+  bool next(std::vector<std::string>* fields) {
+    std::string raw;
+    while (std::getline(in_, raw)) {
+      ++line_;
+      const std::string line = trim(raw);
+      if (line.empty() || line[0] == '#') continue;
+      *fields = splitCsv(line);
+      if (col_.empty()) {
+        readHeader(*fields);
+        continue;
+      }
+      if (fields->size() != col_.size()) {
+        fail("row has " + std::to_string(fields->size()) + " fields, the header has " + std::to_string(col_.size()));
+      }
+      return true;
+    }
+    return false;
+  }
+
+  bool has(const char* column) const { return col_.count(column) > 0; }
+  bool hasHeader() const { return !col_.empty(); }
+  const std::string& name() const { return name_; }
+  const std::string& text(const std::vector<std::string>& fields, const char* column) const {
+    return fields[static_cast<std::size_t>(col_.at(column))];
+  }
+
+  // The finite number in `column` of the row (fallback when the file has no such column).
+  double number(const std::vector<std::string>& fields, const char* column, double fallback = 0.0) const {
+    if (!has(column)) return fallback;
+    const std::string& t = text(fields, column);
+    char* end = nullptr;
+    const double v = std::strtod(t.c_str(), &end);
+    if (t.empty() || end != t.c_str() + t.size() || !std::isfinite(v)) {
+      fail(std::string("column '") + column + "' has value '" + t + "', expected a finite number");
+    }
+    return v;
+  }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InputError(name_ + ":" + std::to_string(line_) + ": " + what);
+  }
+
+ private:
+  void readHeader(const std::vector<std::string>& fields) {
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      if (std::find(allowed_.begin(), allowed_.end(), fields[i]) == allowed_.end()) {
+        fail("unknown column '" + fields[i] + "' (" + hint_ + ")");
+      }
+      if (!col_.emplace(fields[i], static_cast<int>(i)).second) fail("column '" + fields[i] + "' appears twice");
+    }
+    for (const std::string& c : required_) {
+      if (!has(c.c_str())) fail("missing required column '" + c + "'");
+    }
+    if (check_) check_(*this);
+  }
+
+  std::ifstream in_;
+  std::string name_;
+  std::vector<std::string> allowed_;
+  std::vector<std::string> required_;
+  std::string hint_;
+  std::function<void(const HeaderedCsv&)> check_;
+  std::map<std::string, int> col_;  // column name -> index in the row
+  int line_ = 0;
+};
+
 }  // namespace
 
 std::vector<planner::Pose4> readPathCsv(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot open path file");
-  const std::string name = file.string();
-  auto fail = [&](int line, const std::string& what) {
-    throw InputError(name + ":" + std::to_string(line) + ": " + what);
-  };
-  std::map<std::string, int> col;
+  HeaderedCsv csv(file, "path", {"x", "y", "z", "yaw"}, {"x", "y", "z", "yaw"}, "a path has the columns x,y,z,yaw");
   std::vector<planner::Pose4> path;
-  std::string raw;
-  int line_no = 0;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    const std::string line = trim(raw);
-    if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsv(line);
-    if (col.empty()) {
-      for (std::size_t i = 0; i < fields.size(); ++i) {
-        if (fields[i] != "x" && fields[i] != "y" && fields[i] != "z" && fields[i] != "yaw") {
-          fail(line_no, "unknown column '" + fields[i] + "' (a path has the columns x,y,z,yaw)");
-        }
-        if (!col.emplace(fields[i], static_cast<int>(i)).second) {
-          fail(line_no, "column '" + fields[i] + "' appears twice");
-        }
-      }
-      for (const char* c : {"x", "y", "z", "yaw"}) {
-        if (!col.count(c)) fail(line_no, std::string("missing required column '") + c + "'");
-      }
-      continue;
-    }
-    if (fields.size() != col.size()) {
-      fail(line_no,
-           "row has " + std::to_string(fields.size()) + " fields, the header has " + std::to_string(col.size()));
-    }
-    auto value = [&](const char* c) {
-      const std::string& text = fields[static_cast<std::size_t>(col.at(c))];
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-        fail(line_no, std::string("column '") + c + "' has value '" + text + "', expected a finite number");
-      }
-      return v;
-    };
+  std::vector<std::string> fields;
+  while (csv.next(&fields)) {
     planner::Pose4 p;
-    p.p_WB = Eigen::Vector3d(value("x"), value("y"), value("z"));
-    p.yaw_rad = value("yaw");
+    p.p_WB = Eigen::Vector3d(csv.number(fields, "x"), csv.number(fields, "y"), csv.number(fields, "z"));
+    p.yaw_rad = csv.number(fields, "yaw");
     path.push_back(p);
   }
-  if (col.empty()) throw InputError(name + ": empty path file (no header row)");
+  if (!csv.hasHeader()) throw InputError(csv.name() + ": empty path file (no header row)");
   if (path.size() < 2) {
-    throw InputError(name + ": a path needs at least 2 waypoints, this one has " + std::to_string(path.size()));
+    throw InputError(csv.name() + ": a path needs at least 2 waypoints, this one has " + std::to_string(path.size()));
   }
   return path;
 }
 
 control::SetpointTrajectory readTrajectoryCsv(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string() + ": cannot open trajectory file");
-  const std::string name = file.string();
-  auto fail = [&](int line, const std::string& what) {
-    throw InputError(name + ":" + std::to_string(line) + ": " + what);
+  // The feed-forward groups come whole or not at all.
+  auto groups = [](const HeaderedCsv& csv) {
+    for (const auto& group :
+         {std::array<const char*, 3>{"vx", "vy", "vz"}, std::array<const char*, 3>{"ax", "ay", "az"}}) {
+      const int present = static_cast<int>(csv.has(group[0])) + static_cast<int>(csv.has(group[1])) +
+                          static_cast<int>(csv.has(group[2]));
+      if (present != 0 && present != 3) {
+        csv.fail(std::string("columns ") + group[0] + "," + group[1] + "," + group[2] +
+                 " come all together or not at all");
+      }
+    }
   };
-
-  std::map<std::string, int> col;  // column name -> index in the row
+  HeaderedCsv csv(file, "trajectory", {kColumns.begin(), kColumns.end()}, {"t", "x", "y", "z", "yaw"},
+                  "columns: t,x,y,z,yaw and optionally vx,vy,vz,ax,ay,az,yaw_rate", groups);
   std::vector<double> times;
   std::vector<control::TrajectorySetpoint> setpoints;
-  std::string raw;
-  int line_no = 0;
-  while (std::getline(in, raw)) {
-    ++line_no;
-    const std::string line = trim(raw);
-    if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsv(line);
-    if (col.empty()) {
-      for (std::size_t i = 0; i < fields.size(); ++i) {
-        bool known = false;
-        for (const char* c : kColumns) known = known || fields[i] == c;
-        if (!known) {
-          fail(line_no,
-               "unknown column '" + fields[i] + "' (columns: t,x,y,z,yaw and optionally vx,vy,vz,ax,ay,az,yaw_rate)");
-        }
-        if (!col.emplace(fields[i], static_cast<int>(i)).second) {
-          fail(line_no, "column '" + fields[i] + "' appears twice");
-        }
-      }
-      for (const char* c : {"t", "x", "y", "z", "yaw"}) {
-        if (!col.count(c)) fail(line_no, std::string("missing required column '") + c + "'");
-      }
-      for (const auto& group :
-           {std::array<const char*, 3>{"vx", "vy", "vz"}, std::array<const char*, 3>{"ax", "ay", "az"}}) {
-        const int present = static_cast<int>(col.count(group[0]) + col.count(group[1]) + col.count(group[2]));
-        if (present != 0 && present != 3) {
-          fail(line_no, std::string("columns ") + group[0] + "," + group[1] + "," + group[2] +
-                            " come all together or not at all");
-        }
-      }
-      continue;
-    }
-    if (fields.size() != col.size()) {
-      fail(line_no,
-           "row has " + std::to_string(fields.size()) + " fields, the header has " + std::to_string(col.size()));
-    }
-    auto value = [&](const char* c, double fallback) {
-      const auto it = col.find(c);
-      if (it == col.end()) return fallback;
-      const std::string& text = fields[it->second];
-      char* end = nullptr;
-      const double v = std::strtod(text.c_str(), &end);
-      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-        fail(line_no, std::string("column '") + c + "' has value '" + text + "', expected a finite number");
-      }
-      return v;
-    };
-    const double t = value("t", 0.0);
+  std::vector<std::string> fields;
+  while (csv.next(&fields)) {
+    const double t = csv.number(fields, "t");
     if (!times.empty() && !(t > times.back())) {
       char prev[64];
       std::snprintf(prev, sizeof(prev), "%g", times.back());
-      fail(line_no,
-           "column 't' has value '" + fields[col["t"]] + "', not after the previous " + prev + " (time must increase)");
+      csv.fail("column 't' has value '" + csv.text(fields, "t") + "', not after the previous " + prev +
+               " (time must increase)");
     }
     control::TrajectorySetpoint sp;
-    sp.p_WB = Eigen::Vector3d(value("x", 0), value("y", 0), value("z", 0));
-    sp.yaw_rad = value("yaw", 0);
-    sp.v_WB = Eigen::Vector3d(value("vx", 0), value("vy", 0), value("vz", 0));
-    sp.a_WB = Eigen::Vector3d(value("ax", 0), value("ay", 0), value("az", 0));
-    sp.yaw_rate_rad_s = value("yaw_rate", 0);
+    sp.p_WB = Eigen::Vector3d(csv.number(fields, "x"), csv.number(fields, "y"), csv.number(fields, "z"));
+    sp.yaw_rad = csv.number(fields, "yaw");
+    sp.v_WB = Eigen::Vector3d(csv.number(fields, "vx"), csv.number(fields, "vy"), csv.number(fields, "vz"));
+    sp.a_WB = Eigen::Vector3d(csv.number(fields, "ax"), csv.number(fields, "ay"), csv.number(fields, "az"));
+    sp.yaw_rate_rad_s = csv.number(fields, "yaw_rate");
     times.push_back(t);
     setpoints.push_back(sp);
   }
-  if (col.empty()) throw InputError(name + ": empty trajectory file (no header row)");
-  if (times.empty()) throw InputError(name + ": trajectory has a header but no setpoints");
+  if (!csv.hasHeader()) throw InputError(csv.name() + ": empty trajectory file (no header row)");
+  if (times.empty()) throw InputError(csv.name() + ": trajectory has a header but no setpoints");
   return control::SetpointTrajectory(std::move(times), std::move(setpoints));
 }
 

@@ -155,14 +155,19 @@ TEST(Covisibility, BlindAndDegeneratePaths) {
 // A textured wall (face y = 3, x in [0, 4]) beside a straight path along y = 1.45; a thin
 // occluder at y in [1.6, 1.7] starting at x = 4 hides the wall once the camera passes under it,
 // so V(p) collapses within a few centimetres after x = 4.
-TEST(Covisibility, SplitMatchesBruteForceVisibilityOnTheVoxelMap) {
+testing::SyntheticWorld wallBehindOccluder(double texture_spacing_m) {
   testing::SyntheticWorld w;
   w.min_W = {0.0, 0.0, 0.0};
   w.max_W = {10.0, 3.5, 2.5};
   const Eigen::AlignedBox3d wall(Eigen::Vector3d(0.0, 3.0, 0.0), Eigen::Vector3d(4.0, 3.3, 2.5));
   const Eigen::AlignedBox3d occluder(Eigen::Vector3d(4.0, 1.6, 0.0), Eigen::Vector3d(10.0, 1.7, 2.5));
   w.solids = {wall, occluder};
-  w.texture(wall, Eigen::Vector3d(0, -1, 0), 0.1);
+  w.texture(wall, Eigen::Vector3d(0, -1, 0), texture_spacing_m);
+  return w;
+}
+
+TEST(Covisibility, SplitMatchesBruteForceVisibilityOnTheVoxelMap) {
+  const testing::SyntheticWorld w = wallBehindOccluder(0.1);
   const FeatureMap map = w.build();
   ASSERT_EQ(map.landmarks().size(), 1000u);
   const VoxelMap voxels(map, w.min_W, w.max_W);
@@ -264,13 +269,7 @@ TEST(Covisibility, ConfigValidationNamesTheField) {
 // landmarks. The segments are those over ids: the same split points, ratios, and co-visible sets
 // (as voxels). The wall carries several landmarks per voxel so that the weights count.
 TEST(Covisibility, VoxelSlotsWeightedByLandmarksSplitAsIds) {
-  testing::SyntheticWorld w;
-  w.min_W = {0.0, 0.0, 0.0};
-  w.max_W = {10.0, 3.5, 2.5};
-  const Eigen::AlignedBox3d wall(Eigen::Vector3d(0.0, 3.0, 0.0), Eigen::Vector3d(4.0, 3.3, 2.5));
-  const Eigen::AlignedBox3d occluder(Eigen::Vector3d(4.0, 1.6, 0.0), Eigen::Vector3d(10.0, 1.7, 2.5));
-  w.solids = {wall, occluder};
-  w.texture(wall, Eigen::Vector3d(0, -1, 0), 0.04);
+  const testing::SyntheticWorld w = wallBehindOccluder(0.04);  // the wall of the test above, denser
   const FeatureMap map = w.build();
   const VoxelMap voxels(map, w.min_W, w.max_W);
   ASSERT_LT(voxels.landmarkVoxels().size(), map.landmarks().size() / 2);  // several per voxel
