@@ -470,8 +470,6 @@ TEST(CliVo, BadSequencesAreOneLineExit2AndWriteNothing) {
        "/depth.txt:3: timestamp 0.05 does not increase", ""},
       {"missing_depth", [](const std::filesystem::path& s) { std::filesystem::remove(s / "depth/0.100000.png"); },
        "/depth/0.100000.png (depth.txt:6): no such image file", ""},
-      {"corrupt_depth", [](const std::filesystem::path& s) { test::writeFile(s / "depth/0.150000.png", "junk"); },
-       "/depth/0.150000.png (depth.txt:7): cannot read image", ""},
       {"no_intrinsics", [](const std::filesystem::path& s) { std::filesystem::remove(s / "intrinsics.yaml"); },
        "/intrinsics.yaml: missing; give the camera as --intrinsics fx,fy,cx,cy", ""},
       {"bad_intrinsics_option", [](const std::filesystem::path&) {}, "", " --intrinsics 50,50,31.5"},
@@ -488,6 +486,23 @@ TEST(CliVo, BadSequencesAreOneLineExit2AndWriteNothing) {
     EXPECT_FALSE(std::filesystem::exists(out)) << c.name;
     EXPECT_EQ(test::stagingLeftIn(out.parent_path()), 0) << c.name;
   }
+}
+
+// An image file that no decoder reads. Apart from the other bad sequences: OpenCV's imread then
+// loads GDAL's plugins, whose thread-local storage crashes LeakSanitizer's tracer at exit (a
+// runtime bug, not a finding), so scripts/sanitize.sh leaves this one test out.
+TEST(CliVo, CorruptImageIsOneLineExit2AndWritesNothing) {
+  const auto dir = test::tempDir();
+  const auto out = dir / "out";
+  const auto seq = smallSequence(dir / "corrupt_depth");
+  test::writeFile(seq / "depth/0.150000.png", "junk");
+  const CmdResult run = tgnav("vo --sequence " + seq.string() + " --out " + out.string());
+  EXPECT_EQ(run.rc, 2) << run.output;
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find(seq.string() + "/depth/0.150000.png (depth.txt:7): cannot read image"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_EQ(test::stagingLeftIn(dir), 0);
 }
 
 TEST(CliVo, ConfigErrorsNameTheFileAndKey) {
