@@ -165,21 +165,21 @@ EvalResult runEval(const EvalJob& job) {
   if (!job.out.empty()) result.out = newOutputDir(job.out, "tgnav eval");
   const std::vector<vo::StampedPose> ref = readTrajectory(job.ref, settings.format);
   const std::vector<vo::StampedPose> est = readTrajectory(job.est, settings.format);
-  for (const auto& [file, poses] : {std::pair{&job.ref, &ref}, std::pair{&job.est, &est}}) {
-    const int n = vo::nonIncreasingTimes(*poses);
-    if (n > 0 && settings.format != vo::TrajectoryFormat::kKitti) {
-      result.warnings.push_back(
-          "tgnav eval: warning: " + file->string() + ": " + std::to_string(n) +
-          " of its timestamps repeat or go back; poses are paired by evo's rule (nearest in time, "
-          "ties to the first in the file)");
-    }
-  }
   const std::vector<vo::PosePair> pairs = associated(job, settings.format, ref, est);
   const vo::ApeResult ape = vo::absolutePoseError(pairs, settings.align);
   // RPE of the aligned estimate: a rigid alignment leaves it unchanged, sim3's scale does not.
   const std::vector<vo::PosePair> aligned = vo::alignedPairs(pairs, ape.alignment);
   const vo::RpeStatistics rpe = vo::rpeStatistics(aligned, job.rpe_delta, settings.rpe_unit);
   result.summary = summaryJson(job, settings, ref, est, ape, rpe);
+  for (const auto& [file, key] :
+       {std::pair{&job.ref, "ref_non_increasing"}, std::pair{&job.est, "est_non_increasing"}}) {
+    const int n = result.summary[key].get<int>();
+    if (n > 0) {
+      result.warnings.push_back("tgnav eval: warning: " + file->string() + ": " + std::to_string(n) +
+                                " of its timestamps repeat or go back; poses are paired by evo's rule (nearest in "
+                                "time, ties to the first in the file)");
+    }
+  }
   if (result.out.empty()) return result;
 
   StagedDir staged(result.out);

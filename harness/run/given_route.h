@@ -17,7 +17,7 @@ namespace tgnav::harness {
 
 constexpr double kGivenStartTolerance_m = 0.1;
 
-// `voxels`: planningVoxels() of the scenario's map.
+// `voxels`: buildPlanningVoxels() of the scenario's map.
 void checkGivenTrajectory(const Scenario& scenario, const planner::VoxelMap& voxels,
                           const control::SetpointTrajectory& trajectory, const std::string& file);
 void checkGivenPath(const Scenario& scenario, const planner::VoxelMap& voxels, const std::vector<planner::Pose4>& path,

@@ -35,17 +35,22 @@ void makeTrajectory(const Scenario& scenario, PlanRun* run) {
     run->trajectory.reason = "no path";
     return;
   }
+  smoothPath(scenario, plan.path, &run->plan.topo.obstacle_points, run);
+}
+
+}  // namespace
+
+void smoothPath(const Scenario& scenario, const std::vector<planner::Pose4>& path,
+                const std::vector<Eigen::Vector2d>* obstacle_points, PlanRun* run) {
   const auto t0 = std::chrono::steady_clock::now();
   planner::TrajectoryRequest request;
-  request.path = plan.path;
+  request.path = path;
   request.start_yaw_rad = scenario.scene.start.yaw_rad;
-  request.obstacle_points = &run->plan.topo.obstacle_points;
+  request.obstacle_points = obstacle_points;
   const planner::VoxelClearance field(*run->voxels);
   run->trajectory = planner::generateTrajectory(request, field, scenario.planner.trajectory);
   run->trajectory_s = since(t0);
 }
-
-}  // namespace
 
 control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz) {
   if (!run.trajectory.trajectory) throw std::logic_error("setpoints: the plan has no trajectory");
@@ -87,12 +92,14 @@ ClearanceBand clearanceBand(const Scenario& scenario) {
   return {z - reach - 0.2, z + reach + 0.2};
 }
 
-std::unique_ptr<planner::VoxelMap> planningVoxels(const Scenario& scenario, const planner::FeatureMap& map) {
+void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run) {
+  const auto t0 = std::chrono::steady_clock::now();
   const SceneConfig& scene = scenario.scene;
   const ClearanceBand band = clearanceBand(scenario);
-  return std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
-                                             scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m), band.lo_m,
-                                             band.hi_m);
+  run->voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
+                                                    scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
+                                                    band.lo_m, band.hi_m);
+  run->voxel_map_s = since(t0);
 }
 
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
@@ -100,9 +107,7 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
   PlanRun run;
   run.planner = kind;
   run.seed = seed;
-  auto t0 = std::chrono::steady_clock::now();
-  run.voxels = planningVoxels(scenario, map);
-  run.voxel_map_s = since(t0);
+  buildPlanningVoxels(scenario, map, &run);
 
   planner::RrtStarConfig rrt = scenario.planner.rrt_star;
   if (kind == planner::PlannerKind::kRrtStar) {
@@ -122,7 +127,7 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
   const auto solver = planner::makePlanner(kind, *run.voxels, scenario.planner.perception, rrt);
   planner::PlanRequest request{scenario.scene.start, scenario.scene.goal, seed};
   request.homology_class = oracle;
-  t0 = std::chrono::steady_clock::now();
+  const auto t0 = std::chrono::steady_clock::now();
   run.plan = solver->solve(request);
   run.solve_s = since(t0);
   const auto classes = static_cast<int>(run.plan.topo.classes.size());

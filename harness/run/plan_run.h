@@ -5,6 +5,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "control/trajectory.h"
 #include "harness/config/scenario.h"
@@ -40,10 +41,15 @@ struct ClearanceBand {
   double hi_m = 0.0;
 };
 ClearanceBand clearanceBand(const Scenario& scenario);
-// The planners' dense voxel map of `map`: the scene's bounds widened by 0.5 m (walls lie just
-// outside the free-space bounds and must be inside the box to be seen and avoided), with the
-// distance field over clearanceBand().
-std::unique_ptr<planner::VoxelMap> planningVoxels(const Scenario& scenario, const planner::FeatureMap& map);
+// The planners' dense voxel map of `map` into run->voxels (its time into voxel_map_s): the scene's
+// bounds widened by 0.5 m (walls lie just outside the free-space bounds and must be inside the box
+// to be seen and avoided), with the distance field over clearanceBand().
+void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run);
+// `path` as a trajectory from the scene's start pose (the vehicle may turn on the spot first), kept
+// at the configured clearance, into run->trajectory (its time into trajectory_s); with
+// `obstacle_points`, also in the path's homology class. Needs run->voxels.
+void smoothPath(const Scenario& scenario, const std::vector<planner::Pose4>& path,
+                const std::vector<Eigen::Vector2d>* obstacle_points, PlanRun* run);
 
 // `--class K`: sets scenario->planner.oracle_class; InputError for K < 0 or with RRT*, which has
 // no homology classes to fly.

@@ -375,12 +375,10 @@ class ClosedLoop {
 TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
                      const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   TrialResult result;
-  if (options.given_trajectory || options.given_path) {
+  if (options.given()) {
     result.plan.planner = options.planner;
     result.plan.seed = options.seed;
-    const auto t0 = std::chrono::steady_clock::now();
-    result.plan.voxels = planningVoxels(scenario, map);
-    result.plan.voxel_map_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    buildPlanningVoxels(scenario, map, &result.plan);
     if (options.given_trajectory) {
       checkGivenTrajectory(scenario, *result.plan.voxels, *options.given_trajectory, options.given_file);
       result.setpoints = options.given_trajectory;
@@ -388,13 +386,7 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
       checkGivenPath(scenario, *result.plan.voxels, *options.given_path, options.given_file);
       // Smoothed as a plan's path is, without the homology check (a given path has no class).
       result.plan.plan.path = *options.given_path;
-      planner::TrajectoryRequest request;
-      request.path = *options.given_path;
-      request.start_yaw_rad = scenario.scene.start.yaw_rad;
-      const auto t1 = std::chrono::steady_clock::now();
-      result.plan.trajectory = planner::generateTrajectory(request, planner::VoxelClearance(*result.plan.voxels),
-                                                           scenario.planner.trajectory);
-      result.plan.trajectory_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+      smoothPath(scenario, result.plan.plan.path, nullptr, &result.plan);
       if (!result.plan.trajectory.trajectory) {
         result.status = TrialStatus::kPlanFailed;
         result.detail = "trajectory generation failed: " + result.plan.trajectory.reason;

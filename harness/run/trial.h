@@ -45,6 +45,9 @@ struct TrialOptions {
   std::optional<std::vector<planner::Pose4>> given_path;
   std::string given_file;
   bool given() const { return given_trajectory.has_value() || given_path.has_value(); }
+  // "trajectory" or "path" (its option without the dashes, and the planner's name in results);
+  // nullptr when the trial plans.
+  const char* givenKind() const { return given_path ? "path" : given_trajectory ? "trajectory" : nullptr; }
 };
 
 struct TrialProgress {

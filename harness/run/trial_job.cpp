@@ -105,7 +105,7 @@ std::string voCsv(const TrialResult& r) {
 
 void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
   if (options.given()) {
-    const char* kind = options.given_path ? "path" : "trajectory";
+    const char* kind = options.givenKind();
     writeFileAtomic(d / "config.yaml", std::string("# tgnav trial --") + kind + " " + options.given_file + " --seed " +
                                            std::to_string(options.seed) + "\n" + resolvedScenarioYaml(scenario));
     nlohmann::ordered_json plan;
@@ -148,7 +148,7 @@ std::string summaryLine(const Scenario& scenario, const TrialOptions& options, c
   std::ostringstream line;
   line.precision(3);
   line << "tgnav trial: " << scenario.scene.source.stem().string() << ' '
-       << (options.given() ? std::string(options.given_path ? "path " : "trajectory ") + options.given_file
+       << (options.given() ? std::string(options.givenKind()) + " " + options.given_file
                            : planner::toString(options.planner))
        << " seed " << options.seed << ": " << toString(r.status) << " (" << r.detail << ")";
   if (r.status != TrialStatus::kPlanFailed) {

@@ -95,7 +95,7 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["scenario"] = scenario.source.string();
   j["scene"] = scenario.scene.source.stem().string();
   const bool given = options.given();
-  j["planner"] = options.given_path ? "path" : given ? "trajectory" : toString(options.planner);
+  j["planner"] = given ? options.givenKind() : toString(options.planner);
   j["given_file"] = given ? ordered_json(options.given_file) : ordered_json(nullptr);
   j["samples"] = options.planner == planner::PlannerKind::kRrtStar && !given ? ordered_json(result.plan.rrt_samples)
                                                                              : ordered_json(nullptr);

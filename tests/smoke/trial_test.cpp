@@ -48,6 +48,15 @@ std::string deterministicMetrics(const std::filesystem::path& dir) {
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
+// `tgnav trial ARGS --out OUT` is bad input: exit 2, one line that holds `expected`, nothing at OUT.
+void expectRefused(const std::string& args, const std::string& expected, const std::filesystem::path& out) {
+  const CmdResult run = shell(trialCommand(args + " --out " + out.string()));
+  EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
+  EXPECT_EQ(lines(run.output), 1) << args << "\n" << run.output;
+  EXPECT_NE(run.output.find(expected), std::string::npos) << args << "\n" << run.output;
+  EXPECT_FALSE(std::filesystem::exists(out)) << args;
+}
+
 // What every finished trial folder holds, with the metrics' schema.
 void expectTrialFolder(const std::filesystem::path& dir) {
   for (const char* f : {"metrics.json", "gt.tum", "est.tum", "plan.json", "config.yaml", "topdown.png", "ate.png",
@@ -221,13 +230,7 @@ TEST(SmokeTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
       {"--set seed=-1", "seed"},
       {"--frames 99", "--frames: 99"},
   };
-  for (const auto& [args, expected] : cases) {
-    const CmdResult run = shell(trialCommand(args + " --out " + out.string()));
-    EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
-    EXPECT_EQ(lines(run.output), 1) << args << "\n" << run.output;
-    EXPECT_NE(run.output.find(expected), std::string::npos) << args << "\n" << run.output;
-    EXPECT_FALSE(std::filesystem::exists(out)) << args;
-  }
+  for (const auto& [args, expected] : cases) expectRefused(args, expected, out);
   // An output folder that cannot be made.
   const CmdResult unwritable = shell(trialCommand("--out /proc/tgnav_no/trial"));
   EXPECT_EQ(unwritable.rc, 2) << unwritable.output;
@@ -300,14 +303,11 @@ TEST(SmokeTrialCli, GivenPathIsSmoothedAndFlown) {
   const std::filesystem::path through = dir / "through.csv";
   std::ofstream(through) << "x,y,z,yaw\n-3,0,1,0\n3,0,1,0\n";
   const auto out = dir / "through";
-  const CmdResult refused = shell(trialCommand("--path " + through.string() + " --out " + out.string()));
-  EXPECT_EQ(refused.rc, 2) << refused.output;
-  EXPECT_EQ(lines(refused.output), 1) << refused.output;
-  EXPECT_NE(refused.output.find(through.string() + ": waypoint 2 at (3.00, 0.00, 1.00): the straight line from the "
-                                                   "one before passes closer than the robot radius"),
-            std::string::npos)
-      << refused.output;
-  EXPECT_FALSE(std::filesystem::exists(out));
+  expectRefused("--path " + through.string(),
+                through.string() +
+                    ": waypoint 2 at (3.00, 0.00, 1.00): the straight line from the one before "
+                    "passes closer than the robot radius",
+                out);
   const std::filesystem::path bad = dir / "bad.csv";
   std::ofstream(bad) << "x,y,z\n-3,0,1\n";
   const CmdResult header = shell(trialCommand("--path " + bad.string() + " --out " + out.string()));
@@ -345,13 +345,7 @@ TEST(SmokeTrialCli, GivenTrajectoryThroughAWallOrAwayFromTheStartIsRefused) {
       {"--trajectory " + through + " --planner agnostic", "--trajectory: flies what it is given; --planner"},
       {"--trajectory " + through + " --class 1", "--trajectory: flies what it is given; --class"},
   };
-  for (const auto& [args, expected] : cases) {
-    const CmdResult run = shell(trialCommand(args + " --out " + out.string()));
-    EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
-    EXPECT_EQ(lines(run.output), 1) << args << "\n" << run.output;
-    EXPECT_NE(run.output.find(expected), std::string::npos) << args << "\n" << run.output;
-    EXPECT_FALSE(std::filesystem::exists(out)) << args;
-  }
+  for (const auto& [args, expected] : cases) expectRefused(args, expected, out);
 }
 
 // The oracle (--class K) flies class K instead of the planner's choice; a class that does not
