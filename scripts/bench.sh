@@ -165,7 +165,7 @@ for name in sorted(f for f in os.listdir(out) if f.endswith(".json") and f != "b
             if key in ("ms_per_frame", "us_per_step", "us_per_cycle", "real_time_factor", "queries_per_s",
                        "landmarks_per_query", "ms_per_plan", "classes", "ms_per_trajectory",
                        "path_length_m", "optimised", "ate_percent", "lost_frames", "ms_per_query",
-                       "working_factor", "solved"):
+                       "working_factor", "solved", "ms_total", "ms_overhead"):
                 rows.append({"benchmark": b["name"], "figure": key, "value": value})
         if b["name"].startswith("BM_GridPreprocess"):  # a grid map's graph, built once per map and radius
             rows.append({"benchmark": b["name"], "figure": "ms_preprocess", "value": b["real_time"]})

@@ -51,7 +51,12 @@ harness::ProgressFn terminalProgress() {
 
 int runTrialCommand(TrialCliOptions& opt) {
   harness::TrialJob& job = opt.job;
-  job.planner = harness::parsePlannerName(opt.planner, "--planner");
+  // --planner-command implies an external planner; "external" names the scenario's.
+  job.external = opt.planner == "external" || !job.external_command.empty();
+  if (job.external && opt.planner != "external" && opt.planner != "proposed") {
+    throw InputError("--planner-command: runs an external planner; drop --planner " + opt.planner);
+  }
+  if (!job.external) job.planner = harness::parsePlannerName(opt.planner, "--planner");
   if (opt.seed < -1) throw InputError("--seed: " + std::to_string(opt.seed) + " must be >= 0");
   if (opt.seed >= 0) job.seed = static_cast<std::uint64_t>(opt.seed);
   job.figure_format = harness::parseFigureFormat(opt.figure_format);
@@ -87,7 +92,17 @@ void addTrialCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "trial", "Plan, fly closed loop with the onboard camera and VO, and score: metrics.json, gt/est.tum, plots");
   cmd->add_option("--scenario", job.scenario, "Scenario YAML (configs/scenarios/*.yaml)")->required();
-  cmd->add_option("--planner", opt->planner, "proposed | agnostic | rrtstar")->capture_default_str();
+  cmd->add_option("--planner", opt->planner,
+                  "proposed | agnostic | rrtstar | external (the scenario's planner.external; "
+                  "docs/PLANNER_PROTOCOL.md)")
+      ->capture_default_str();
+  cmd->add_option("--planner-command", job.external_command,
+                  "Fly the route of this external planner command (run with /bin/sh -c; JSON lines protocol, "
+                  "docs/PLANNER_PROTOCOL.md)");
+  cmd->add_option("--planner-name", job.external_name,
+                  "The external planner's name in results (default: the scenario's, or \"external\")");
+  cmd->add_option("--planner-dir", job.external_dir,
+                  "The external planner command's working directory (default: the current one)");
   cmd->add_option("--samples", job.samples, "rrtstar: iteration budget N (default: planner config)");
   cmd->add_option("--seed", opt->seed, "Seed of the planner, camera noise and IMU (default: the scenario's)");
   cmd->add_option("--out", job.out, "Results folder (new or empty; see --force)")->required();

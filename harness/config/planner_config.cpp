@@ -1,5 +1,8 @@
 #include "harness/config/planner_config.h"
 
+#include <stdexcept>
+#include <string>
+
 #include "harness/config/check.h"
 
 namespace tgnav::harness {
@@ -28,6 +31,11 @@ void PlannerSettings::validate() const {
   perception.validate();
   rrt_star.validate();
   trajectory.validate();
+  try {
+    external.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string("external.") + e.what());
+  }
   require(oracle_class >= -1, "oracle_class", oracle_class, "must be -1 (the planner chooses) or a class index >= 0");
 }
 

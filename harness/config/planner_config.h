@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "harness/config/external_planner_config.h"
 #include "harness/config/yaml_util.h"
 #include "planner/perception_planner.h"
 #include "planner/rrt_star.h"
@@ -21,13 +22,15 @@ struct PlannerSettings {
   // The oracle: >= 0 makes proposed and agnostic fly this homology class (an index into plan.json's
   // classes) instead of choosing one (planner::PlanRequest::homology_class); -1: they choose.
   int oracle_class = -1;
+  // A planner run as a child process (`--planner external`; docs/PLANNER_PROTOCOL.md).
+  ExternalPlannerConfig external;
 
   // The dotted keys of the fields that follow perception's: they have no keys of their own in
   // planner.yaml, and shareFromPerception() sets them.
   static const std::vector<std::string>& sharedKeys();
 
   // The keys of planner.yaml (a scenario's `planner:` section): perception's at the top level,
-  // then `rrt_star:` and `trajectory:`, less sharedKeys(); after each visit the shared fields are
+  // then `rrt_star:`, `trajectory:` and `external:`, less sharedKeys(); after each visit the shared fields are
   // perception's again.
   template <typename Archive>
   void visit(Archive& a) {
@@ -36,6 +39,7 @@ struct PlannerSettings {
     s("rrt_star", rrt_star);
     s("trajectory", trajectory);
     s("oracle_class", oracle_class);
+    s("external", external);
     shareFromPerception();
   }
   // Copies perception's robot radius, visibility, information, slice and topology settings into

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
+#include <system_error>
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
@@ -150,6 +152,24 @@ void readTrackModel(const YamlDoc& doc, const YamlDoc* overrides, PlannerSetting
   planner->shareFromPerception();
 }
 
+// With an external planner configured, makes planner.external.dir absolute: relative to the
+// current directory when --set gives the dir or the command, else to the scenario file; InputError
+// when the folder does not exist.
+void resolveExternalDir(const YamlDoc& doc, const YamlDoc* overrides, PlannerSettings* planner) {
+  ExternalPlannerConfig& ext = planner->external;
+  if (!ext.configured()) return;
+  const YAML::Node set = overrides ? overrides->root()["planner"] : YAML::Node();
+  const bool overridden = set && set["external"] && (set["external"]["dir"] || set["external"]["command"]);
+  const fs::path base = overridden ? fs::path() : doc.file().parent_path();
+  const fs::path dir = fs::absolute(base / ext.dir).lexically_normal();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    throw InputError((overridden ? std::string("--set") : doc.file().string()) +
+                     ": key 'planner.external.dir' has value '" + ext.dir + "': folder " + dir.string() + " not found");
+  }
+  ext.dir = dir.string();
+}
+
 YAML::Node poseYaml(const planner::Pose4& pose) {
   const double v[4] = {pose.p_WB.x(), pose.p_WB.y(), pose.p_WB.z(), pose.yaw_rad};
   return exactSequence(v, 4);
@@ -192,6 +212,7 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
   SectionReader sections(doc, overrides);
   s.visitSections(sections);
   readTrackModel(doc, overrides, &s.planner);
+  resolveExternalDir(doc, overrides, &s.planner);
   return s;
 }
 

@@ -13,6 +13,7 @@
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
+#include "harness/config/external_planner_config.h"
 #include "harness/experiments/report_trial.h"
 #include "harness/experiments/statistics.h"
 #include "harness/experiments/sweep.h"
@@ -161,7 +162,11 @@ IndexRow parseRow(const fs::path& file, const fs::path& dir, int line, const std
   row.line = line;
   row.id = r.required(0);
   row.scene = r.required(1);
-  row.planner = r.oneOf(2, kPlanners);
+  row.planner = r.required(2);
+  if (std::find(kPlanners.begin(), kPlanners.end(), row.planner) == kPlanners.end() &&
+      !isExternalPlannerName(row.planner)) {
+    r.fail(2, "'" + row.planner + "' is not one of " + joined(kPlanners, ", ") + " nor an external planner's name");
+  }
   row.samples = static_cast<int>(r.integer(3, 0, 1000000000));
   row.seed = static_cast<std::uint64_t>(r.integer(4, 0, std::numeric_limits<long long>::max()));
   row.params = r.text(5);

@@ -13,6 +13,7 @@
 #include "harness/base/shell.h"
 #include "harness/config/scenario.h"
 #include "harness/config/yaml_util.h"
+#include "harness/experiments/sweep_planners.h"
 #include "harness/experiments/sweep_scenes.h"
 #include "harness/run/plan_run.h"
 
@@ -194,7 +195,7 @@ Checked checkConfig(const YamlDoc& doc, const YAML::Node& where, const std::stri
 struct Run {
   std::string context;  // "runs[2]"
   std::vector<fs::path> scenarios;
-  std::vector<std::string> planners;
+  std::vector<SweepPlanner> planners;
   std::vector<int> samples{0};  // 0: the configured budget (and not rrtstar)
   std::vector<std::uint64_t> seeds;
   Assignments own;
@@ -213,22 +214,10 @@ std::vector<fs::path> readScenarios(const YamlDoc& doc, const YAML::Node& run, c
   return scenarios;
 }
 
-std::vector<std::string> readPlanners(const YamlDoc& doc, const YAML::Node& run, const std::string& context) {
-  std::vector<std::string> planners;
-  for (const YAML::Node& p : oneOrList(doc, run, "planner", context)) {
-    try {
-      planners.push_back(toString(parsePlannerName(p.Scalar(), joinKey(context, "planner"))));
-    } catch (const InputError& e) {
-      doc.fail(p, e.what());
-    }
-  }
-  return planners;
-}
-
 std::vector<int> readSamples(const YamlDoc& doc, const YAML::Node& run, const std::string& context,
-                             const std::vector<std::string>& planners) {
+                             const std::vector<SweepPlanner>& planners) {
   if (!run["samples"]) return {0};
-  if (std::any_of(planners.begin(), planners.end(), [](const std::string& p) { return p != "rrtstar"; })) {
+  if (std::any_of(planners.begin(), planners.end(), [](const SweepPlanner& p) { return p.name != "rrtstar"; })) {
     doc.fail(run["samples"], joinKey(context, "samples") + ": only the rrtstar planner takes a sample budget");
   }
   std::vector<int> samples;
@@ -252,7 +241,7 @@ Run readRun(const YamlDoc& doc, const YAML::Node& run, std::size_t r, const fs::
   }
   out.scenarios =
       run["scenario"] ? readScenarios(doc, run, context, source) : readGeneratedScenes(doc, run, context, scenes);
-  out.planners = readPlanners(doc, run, context);
+  out.planners = readSweepPlanners(doc, run, context, source);
   out.samples = readSamples(doc, run, context, out.planners);
   out.seeds = run["seeds"] ? readSeeds(doc, run["seeds"], joinKey(context, "seeds")) : seeds;
   if (out.seeds.empty()) doc.fail(run, context + ": no seeds (give 'seeds' in the sweep or the run)");
@@ -307,17 +296,20 @@ void expandRun(const YamlDoc& doc, const YAML::Node& node, const Run& run, const
                std::map<std::string, Checked>* checked, Sweep* sweep) {
   const std::vector<Settings> combos = axisCombinations(run.own.axes);
   for (const fs::path& scenario : run.scenarios) {
-    for (const std::string& planner : run.planners) {
+    for (const SweepPlanner& planner : run.planners) {
       for (int n : run.samples) {
         for (const Settings& combo : combos) {
           SweepTrial t;
           t.scenario = scenario;
-          t.planner = planner;
+          t.planner = planner.name;
+          t.external_command = planner.external_command;
+          t.external_dir = planner.external_dir;
           t.samples = n;
           assign(&t, common, run.own.fixed, combo);
+          t.set.insert(t.set.end(), planner.set.begin(), planner.set.end());  // not params: not in the id
           const Checked& config = checkOnce(doc, node, run.context, t, checked);
           t.scene = config.scene;
-          if (planner == "rrtstar" && t.samples == 0) t.samples = config.default_samples;
+          if (planner.name == "rrtstar" && t.samples == 0) t.samples = config.default_samples;
           for (std::uint64_t seed : run.seeds) {
             t.seed = seed;
             sweep->trials.push_back(t);
@@ -372,7 +364,13 @@ Sweep loadSweep(const fs::path& yaml, const fs::path& scenes_dir) {
 }
 
 std::vector<std::string> trialArguments(const SweepTrial& t, const fs::path& out) {
-  std::vector<std::string> args{"trial", "--scenario", t.scenario.string(), "--planner", t.planner};
+  std::vector<std::string> args{"trial", "--scenario", t.scenario.string()};
+  if (t.external_command.empty()) {
+    args.insert(args.end(), {"--planner", t.planner});
+  } else {
+    args.insert(args.end(), {"--planner-command", t.external_command, "--planner-name", t.planner, "--planner-dir",
+                             t.external_dir.string()});
+  }
   if (t.planner == "rrtstar") {
     args.push_back("--samples");
     args.push_back(std::to_string(t.samples));

@@ -8,7 +8,8 @@
 //   set: {camera.width_px: 320}     # optional: --set overrides for every trial
 //   runs:
 //     - scenario: ../scenarios/storage.yaml      # one path or a list (relative to this file)
-//       planner: [proposed, agnostic]            # one name or a list
+//       planner: [proposed, agnostic]            # one name or a list; an external planner as
+//                                                # {external: COMMAND, name: NAME} (sweep_planners.h)
 //     - scenario: ../scenarios/storage.yaml
 //       planner: rrtstar
 //       samples: [300, 1000, 2000]               # rrtstar's sample budget (rrtstar only)
@@ -49,8 +50,12 @@ struct SweepTrial {
   std::string id;
   std::filesystem::path scenario;  // absolute
   std::string scene;               // the scenario's scene (its file's stem)
-  std::string planner;             // proposed | agnostic | rrtstar
-  int samples = 0;                 // rrtstar's sample budget; 0 for the others
+  std::string planner;             // proposed | agnostic | rrtstar | an external planner's name
+  // An external planner's command and working directory (sweep_planners.h); "" for a built-in one.
+  // Not in the manifest: commands.txt holds them.
+  std::string external_command;
+  std::filesystem::path external_dir;
+  int samples = 0;  // rrtstar's sample budget; 0 for the others
   std::uint64_t seed = 0;
   // --set overrides, in order: the sweep's, the run's, then the run's axes.
   std::vector<std::pair<std::string, std::string>> set;

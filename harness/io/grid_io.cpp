@@ -12,6 +12,7 @@
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
 #include "harness/config/yaml_util.h"
+#include "harness/io/staged_output.h"
 #include "harness/io/text_fields.h"
 
 namespace tgnav::harness {
@@ -243,6 +244,23 @@ planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, doub
     }
   }
   return grid;
+}
+
+void writeRosMap(const planner::OccupancyGrid2D& grid, const std::filesystem::path& yaml,
+                 const std::filesystem::path& pgm) {
+  std::string image = "P5\n" + std::to_string(grid.width) + " " + std::to_string(grid.height) + "\n255\n";
+  image.reserve(image.size() + grid.occupied.size());
+  for (int row = 0; row < grid.height; ++row) {
+    for (int ix = 0; ix < grid.width; ++ix)
+      image += static_cast<char>(grid.isOccupied(ix, grid.height - 1 - row) ? 0 : 254);
+  }
+  writeFileAtomic(pgm, image);
+  std::ostringstream y;
+  y.precision(17);
+  y << "image: " << pgm.filename().string() << "\nresolution: " << grid.resolution_m << "\norigin: ["
+    << grid.origin_m.x() << ", " << grid.origin_m.y() << ", 0.0]\nnegate: 0\noccupied_thresh: 0.65\n"
+    << "free_thresh: 0.196\n";
+  writeFileAtomic(yaml, y.str());
 }
 
 planner::OccupancyGrid2D loadGridMap(const std::filesystem::path& file, double movingai_resolution_m) {

@@ -1,8 +1,8 @@
 #pragma once
-// Loaders for 2D occupancy grids from the two common formats: ROS map_server maps (YAML + PGM)
-// and MovingAI benchmark .map files. Both put image row 0 at the top of the map (largest y),
-// while OccupancyGrid2D stores rows from the lowest y, so every loader flips rows. Bad input
-// throws InputError naming the file, the key or line, and the offending value.
+// Loaders (and a map_server writer) for 2D occupancy grids from the two common formats: ROS map_server maps (YAML +
+// PGM) and MovingAI benchmark .map files. Both put image row 0 at the top of the map (largest y), while OccupancyGrid2D
+// stores rows from the lowest y, so every loader flips rows. Bad input throws InputError naming the file, the key or
+// line, and the offending value.
 #include <filesystem>
 
 #include "planner/occupancy_grid.h"
@@ -20,6 +20,13 @@ planner::OccupancyGrid2D loadRosMap(const std::filesystem::path& yaml);
 // '.', 'G' and 'S' are passable; '@', 'O', 'T' and 'W' are obstacles; any other character is an
 // error naming its line and column. Origin (0, 0); `resolution_m` must be > 0.
 planner::OccupancyGrid2D loadMovingAiMap(const std::filesystem::path& file, double resolution_m);
+
+// Writes `grid` as a map_server map: `yaml` (image: the PGM's file name, resolution, origin
+// [x, y, 0], negate 0, occupied_thresh 0.65, free_thresh 0.196) and the binary PGM `pgm` beside
+// it (0 = occupied, 254 = free, first row the highest y). loadRosMap reads it back exactly.
+// InputError naming the file when it cannot be written.
+void writeRosMap(const planner::OccupancyGrid2D& grid, const std::filesystem::path& yaml,
+                 const std::filesystem::path& pgm);
 
 // By extension: .yaml/.yml -> loadRosMap, .map -> loadMovingAiMap (with movingai_resolution_m).
 planner::OccupancyGrid2D loadGridMap(const std::filesystem::path& file, double movingai_resolution_m);

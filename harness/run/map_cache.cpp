@@ -129,7 +129,8 @@ CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& confi
 }
 
 planner::FeatureMap loadSceneFeatureMap(const SceneConfig& scene, const std::string& map_dir,
-                                        const std::string& cache_root, const std::string& command) {
+                                        const std::string& cache_root, const std::string& command,
+                                        std::filesystem::path* folder) {
   std::filesystem::path dir = map_dir;
   if (dir.empty()) {
     const std::filesystem::path cache = cache_root.empty() ? defaultCacheDir() : std::filesystem::path(cache_root);
@@ -142,6 +143,7 @@ planner::FeatureMap loadSceneFeatureMap(const SceneConfig& scene, const std::str
     if (tty && cached.built) std::fprintf(stderr, "\n");
     dir = cached.dir;
   }
+  if (folder != nullptr) *folder = std::filesystem::absolute(dir).lexically_normal();
   try {
     const QuietStderr quiet;
     return planner::FeatureMap::load(dir);

@@ -37,8 +37,10 @@ CachedMap cachedFeatureMap(const SceneConfig& scene, const MapBuildConfig& confi
 // The scene's feature map for a command: the folder `map_dir` when given (`--map`), else the
 // cached one under `cache_root` (`--map-cache`, default defaultCacheDir()), built on first use
 // with progress on stderr when that is a terminal ("<command>: mapping i/n frames").
-// InputError naming --map when the folder holds no readable map.
+// InputError naming --map when the folder holds no readable map. `folder`, when given, is set to
+// the map's folder (absolute).
 planner::FeatureMap loadSceneFeatureMap(const SceneConfig& scene, const std::string& map_dir,
-                                        const std::string& cache_root, const std::string& command);
+                                        const std::string& cache_root, const std::string& command,
+                                        std::filesystem::path* folder = nullptr);
 
 }  // namespace tgnav::harness

@@ -13,6 +13,7 @@
 // from it (trialSeed).
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "harness/config/scenario.h"
+#include "harness/run/external_plan.h"
 #include "harness/run/frame_prediction.h"
 #include "harness/run/plan_run.h"
 #include "harness/run/trial_profile.h"
@@ -48,7 +50,15 @@ struct TrialOptions {
   // "trajectory" or "path" (its option without the dashes, and the planner's name in results);
   // nullptr when the trial plans.
   const char* givenKind() const { return given_path ? "path" : given_trajectory ? "trajectory" : nullptr; }
+  // Or ask the scenario's external planner (scenario.planner.external; `--planner external`),
+  // sending it the feature map's files in `map_dir` (external_plan.h).
+  bool external = false;
+  std::filesystem::path map_dir;
 };
+
+// The planner's name in results: "trajectory"/"path" for a given route, the external planner's
+// name, or the built-in planner's.
+std::string plannerLabel(const Scenario& scenario, const TrialOptions& options);
 
 struct TrialProgress {
   double sim_s = 0.0;
@@ -69,6 +79,7 @@ struct TrialResult {
   TrialStatus status = TrialStatus::kPlanFailed;
   std::string detail;  // one line: what decided the status
   PlanRun plan;
+  std::optional<ExternalPlan> external;                  // what the external planner did (TrialOptions::external)
   std::optional<control::SetpointTrajectory> setpoints;  // the flown trajectory (none without a plan)
   FlightResult flight;
   Eigen::Isometry3d X_BC = Eigen::Isometry3d::Identity();  // the camera on the body

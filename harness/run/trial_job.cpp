@@ -36,9 +36,45 @@ void checkJob(const TrialJob& job) {
     throw InputError("--trajectory and --path: give one of them (or neither, to plan)");
   }
   const std::string given = !job.trajectory.empty() ? "--trajectory" : !job.path.empty() ? "--path" : "";
-  if (!given.empty() && (job.samples != 0 || job.homology_class)) {
-    throw InputError(given + ": flies what it is given; " + (job.samples != 0 ? "--samples" : "--class") +
+  if (!given.empty() && (job.samples != 0 || job.homology_class || job.external)) {
+    throw InputError(given + ": flies what it is given; " +
+                     (job.samples != 0     ? "--samples"
+                      : job.homology_class ? "--class"
+                                           : "--planner external") +
                      " is for a planner");
+  }
+  if (job.external && (job.samples != 0 || job.homology_class)) {
+    throw InputError(std::string(job.samples != 0 ? "--samples" : "--class") + ": not for an external planner");
+  }
+  if (!job.external && (!job.external_command.empty() || !job.external_name.empty() || !job.external_dir.empty())) {
+    throw InputError("--planner-command, --planner-name and --planner-dir are for --planner external");
+  }
+}
+
+// The command line's external planner over the scenario's (TrialJob::external_command, ...).
+void applyExternal(const TrialJob& job, Scenario* scenario) {
+  ExternalPlannerConfig& ext = scenario->planner.external;
+  if (!job.external_command.empty()) {
+    ext.command = job.external_command;
+    const fs::path dir = fs::absolute(job.external_dir.empty() ? fs::current_path() : job.external_dir);
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+      throw InputError("--planner-dir: '" + job.external_dir.string() + "': folder " + dir.string() + " not found");
+    }
+    ext.dir = dir.lexically_normal().string();
+  } else if (!job.external_dir.empty()) {
+    throw InputError("--planner-dir: goes with --planner-command");
+  }
+  if (!job.external_name.empty()) {
+    if (!isExternalPlannerName(job.external_name)) {
+      throw InputError("--planner-name: '" + job.external_name +
+                       "': 1-40 letters, digits, '_' or '-', and not proposed, agnostic, rrtstar, trajectory or path");
+    }
+    ext.name = job.external_name;
+  }
+  if (!ext.configured()) {
+    throw InputError("--planner external: " + job.scenario.string() +
+                     " sets no planner.external.command; give --planner-command \"...\" or set it");
   }
 }
 
@@ -103,6 +139,59 @@ std::string voCsv(const TrialResult& r) {
   return out.str();
 }
 
+// plan.json of a trial flown on an external planner's route: what it was asked, what it said and
+// how long the protocol took besides the planner's own time.
+nlohmann::ordered_json externalPlanJson(const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
+  using nlohmann::ordered_json;
+  const ExternalPlannerConfig& cfg = scenario.planner.external;
+  ordered_json plan;
+  plan["planner"] = cfg.name;
+  plan["seed"] = options.seed;
+  plan["scenario"] = scenario.source.string();
+  plan["scene"] = scenario.scene.source.string();
+  ordered_json ext;
+  ext["command"] = cfg.command;
+  ext["dir"] = cfg.dir;
+  ext["timeout_s"] = cfg.timeout_s;
+  if (r.external) {
+    const ExternalPlan& e = *r.external;
+    ext["status"] = e.ok ? "ok" : "failed";
+    ext["detail"] = e.detail;
+    ext["reason"] = e.reason;
+    ext["ended"] = e.ended;
+    ext["homology_class"] = e.homology_class ? ordered_json(*e.homology_class) : ordered_json(nullptr);
+    ext["prepare_s"] = e.prepare_s;
+    ext["start_s"] = e.start_s;
+    ext["call_s"] = e.call_s;
+    ext["planner_s"] = e.planner_s ? ordered_json(*e.planner_s) : ordered_json(nullptr);
+    ext["stop_s"] = e.stop_s;
+    ext["check_s"] = e.check_s;
+    ext["total_s"] = e.total_s();
+    ext["overhead_s"] = e.total_s() - e.planner_s.value_or(0.0);
+    if (!e.scores.empty()) ext["scores"] = e.scores;
+  }
+  plan["external"] = ext;
+  ordered_json classes = ordered_json::array();
+  for (const planner::HomologyClass& c : r.plan.plan.topo.classes) classes.push_back({{"length_m", c.length_m}});
+  plan["classes"] = classes;
+  ordered_json path = ordered_json::array();
+  for (const planner::Pose4& p : r.plan.plan.path) path.push_back({p.p_WB.x(), p.p_WB.y(), p.p_WB.z(), p.yaw_rad});
+  plan["path"] = path;
+  if (!r.plan.plan.path.empty()) {
+    const planner::TrajectoryReport& tr = r.plan.trajectory;
+    plan["trajectory"] = {{"status", planner::toString(tr.status)},
+                          {"reason", tr.reason},
+                          {"duration_s", tr.duration_s},
+                          {"length_m", tr.length_m},
+                          {"min_clearance_m", tr.min_clearance_m}};
+  }
+  if (r.setpoints) {
+    plan["setpoints"] = r.setpoints->setpoints().size();
+    plan["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
+  }
+  return plan;
+}
+
 void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
   if (options.given()) {
     const char* kind = options.givenKind();
@@ -128,6 +217,13 @@ void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& 
       plan["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
     }
     writeFileAtomic(d / "plan.json", plan.dump(2) + "\n");
+  } else if (options.external) {
+    const ExternalPlannerConfig& ext = scenario.planner.external;
+    writeFileAtomic(d / "config.yaml", "# tgnav trial --planner external (" + ext.name + ": " + ext.command +
+                                           ") --seed " + std::to_string(options.seed) + "\n" +
+                                           resolvedScenarioYaml(scenario));
+    writeFileAtomic(d / "plan.json", externalPlanJson(scenario, options, r).dump(2) + "\n");
+    writeFileAtomic(d / "planner_stderr.txt", r.external ? r.external->stderr_tail : std::string());
   } else {
     writeFileAtomic(d / "config.yaml", runConfigYaml("trial", scenario, r.plan));
     writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");
@@ -149,7 +245,7 @@ std::string summaryLine(const Scenario& scenario, const TrialOptions& options, c
   line.precision(3);
   line << "tgnav trial: " << scenario.scene.source.stem().string() << ' '
        << (options.given() ? std::string(options.givenKind()) + " " + options.given_file
-                           : planner::toString(options.planner))
+                           : plannerLabel(scenario, options))
        << " seed " << options.seed << ": " << toString(r.status) << " (" << r.detail << ")";
   if (r.status != TrialStatus::kPlanFailed) {
     line << "; flown " << scores.path_length_m << " m, goal error "
@@ -182,13 +278,16 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
     options.given_path = readPathCsv(job.path);
     options.given_file = job.path.string();
   }
+  options.external = job.external;
+  if (job.external) applyExternal(job, &scenario);
   if (job.homology_class) {
     applyOracleClass(*job.homology_class, job.planner, &scenario);
     options.oracle_option = "--class";
   }
   checkOutput(job.out, job.force);
   StagedDir staged(job.out);
-  const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial");
+  const planner::FeatureMap map =
+      loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial", &options.map_dir);
 
   if (job.trial_starting) job.trial_starting();
   const TrialResult r = runTrial(scenario, map, options, progress, interrupt);

@@ -34,6 +34,13 @@ struct TrialJob {
   std::filesystem::path trajectory;
   // Or smooth and fly this 4-DoF path CSV (x,y,z,yaw); "" = plan.
   std::filesystem::path path;
+  // Ask the scenario's external planner instead (`--planner external`, docs/PLANNER_PROTOCOL.md).
+  // `external_command` sets planner.external.command (run in `external_dir`, "" = the current
+  // directory) and `external_name` its name, over the scenario's.
+  bool external = false;
+  std::string external_command;
+  std::string external_name;
+  std::filesystem::path external_dir;
   bool figures = true;  // draw topdown and ate (a sweep leaves them to its report)
   FigureFormat figure_format = FigureFormat::kPng;
   // Called right before the trial (planning and flight) and right after it, before the results

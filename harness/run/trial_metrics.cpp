@@ -95,10 +95,11 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["scenario"] = scenario.source.string();
   j["scene"] = scenario.scene.source.stem().string();
   const bool given = options.given();
-  j["planner"] = given ? options.givenKind() : toString(options.planner);
+  j["planner"] = plannerLabel(scenario, options);
   j["given_file"] = given ? ordered_json(options.given_file) : ordered_json(nullptr);
-  j["samples"] = options.planner == planner::PlannerKind::kRrtStar && !given ? ordered_json(result.plan.rrt_samples)
-                                                                             : ordered_json(nullptr);
+  const bool built_in = !given && !options.external;
+  j["samples"] = options.planner == planner::PlannerKind::kRrtStar && built_in ? ordered_json(result.plan.rrt_samples)
+                                                                               : ordered_json(nullptr);
   j["seed"] = options.seed;
   j["oracle_class"] =
       scenario.planner.oracle_class >= 0 ? ordered_json(scenario.planner.oracle_class) : ordered_json(nullptr);
@@ -126,14 +127,17 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
                                                    {"with", result.collision->what}}
                                     : ordered_json(nullptr);
   const planner::Plan& plan = result.plan.plan;
-  j["plan_status"] = given ? "given" : planner::toString(plan.status);
+  j["plan_status"] = given                                                           ? "given"
+                     : options.external && !(result.external && result.external->ok) ? "failed"
+                                                                                     : planner::toString(plan.status);
   j["classes"] = result.plan.plan.topo.classes.size();
   j["chosen_class"] =
       result.plan.plan.chosen_class >= 0 ? ordered_json(result.plan.plan.chosen_class) : ordered_json(nullptr);
   j["c_p_min"] = plan.chosen >= 0 && std::isfinite(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
                      ? ordered_json(plan.candidates[static_cast<std::size_t>(plan.chosen)].c_p_min)
                      : ordered_json(nullptr);
-  j["trajectory_status"] = options.given_trajectory ? "given" : planner::toString(result.plan.trajectory.status);
+  const bool trajectory_given = options.given_trajectory || (result.external && result.external->trajectory);
+  j["trajectory_status"] = trajectory_given ? "given" : planner::toString(result.plan.trajectory.status);
   const TrackingSummary tracking = summarizeTracking(result.flight);
   j["tracking_rmse_m"] = tracking.position_rmse_m;
   j["vo_poses_fused"] = result.vo_fused;

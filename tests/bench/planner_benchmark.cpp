@@ -1,11 +1,19 @@
 // Topological planning (EDT + GVD + graph + homology classes + shortening) on the gallery scene
 // rasterised at 5 cm at flight height: 440 x 400 cells, start and goal from the scene. And on
 // benchmark-sized grid maps (`tgnav plan --grid`), made by the tests' generators: a map's
-// preprocessing (working grid, distance field, GVD) and then its queries, timed apart.
+// preprocessing (working grid, distance field, GVD) and then its queries, timed apart. And the
+// cost of asking an external planner (docs/PLANNER_PROTOCOL.md) beyond the planner's own time.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+#include <fstream>
+
 #include "../planner/grid_maps.h"
+#include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
+#include "harness/run/external_plan.h"
+#include "harness/run/map_cache.h"
+#include "harness/run/plan_run.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
 #include "planner/topological_planner.h"
@@ -123,6 +131,47 @@ void BM_TrajectoryGallery40m(benchmark::State& state) {
   state.counters["optimised"] = report.status == planner::TrajectoryStatus::kOptimised;
 }
 BENCHMARK(BM_TrajectoryGallery40m)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// One external plan request on the smoke scenario (its feature map from the cache, built on first
+// use; the fixed route goes around the pillar), from writing the map slice to the route checked: Arg(0) a /bin/sh
+// planner that answers a fixed path at once (the protocol's own cost: process start, request, response, parse, checks),
+// Arg(1) the same from Python (tests/data/planners/fake_planner.py fixed; adds the interpreter's
+// start-up). ms_overhead = the whole call less the planner's reported solve_time_s (0).
+void BM_ExternalPlannerOverhead(benchmark::State& state) {
+  const std::string src = TGNAV_SOURCE_DIR;
+  Scenario scenario = loadScenario(src + "/configs/scenarios/smoke.yaml");
+  const std::string response =
+      R"({"protocol":"tgnav-planner","version":1,"id":1,"status":"ok","path":[[-3,0,1,0],[-1,-1.2,1,0],)"
+      R"([1,-1.2,1,0],[3,0,1,0]],)"
+      R"("solve_time_s":0})";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tgnav-bench-external";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "path.json") << "[[-3,0,1,0],[-1,-1.2,1,0],[1,-1.2,1,0],[3,0,1,0]]\n";
+  scenario.planner.external.dir = dir.string();
+  scenario.planner.external.command =
+      state.range(0) == 0 ? "read line; printf '%s\\n' '" + response + "'; read line"
+                          : "/usr/bin/python3 " + src + "/tests/data/planners/fake_planner.py fixed path.json";
+  std::filesystem::path map_dir;
+  const planner::FeatureMap map = loadSceneFeatureMap(scenario.scene, "", "", "planner_benchmark", &map_dir);
+  PlanRun run;
+  buildPlanningVoxels(scenario, map, &run);
+  double total_s = 0.0;
+  double overhead_s = 0.0;
+  bool ok = true;
+  for (auto _ : state) {
+    const ExternalPlan plan = askExternalPlanner(scenario, map_dir, *run.voxels, 1);
+    ok = ok && plan.ok;
+    if (!plan.ok) state.SetLabel(plan.detail);
+    total_s += plan.total_s();
+    overhead_s += plan.total_s() - plan.planner_s.value_or(0.0);
+  }
+  const auto n = static_cast<double>(state.iterations());
+  state.counters["ms_total"] = 1000.0 * total_s / n;
+  state.counters["ms_overhead"] = 1000.0 * overhead_s / n;
+  state.counters["solved"] = ok ? 1 : 0;
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_ExternalPlannerOverhead)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace tgnav::harness

@@ -18,6 +18,7 @@
 #include "harness/experiments/sweep.h"
 #include "harness/io/grid_io.h"
 #include "harness/io/movingai_scen.h"
+#include "harness/io/planner_protocol.h"
 #include "harness/io/trajectory_csv.h"
 #include "harness/io/tum_sequence.h"
 #include "harness/sim/vehicle_model.h"
@@ -126,6 +127,17 @@ Outcome textParser(const Body& body, const std::string& input) {
   }
 }
 
+// The external planner protocol's response parser, documented to throw ProtocolError.
+Outcome protocolParser(const Body& body, const std::string& input) {
+  try {
+    body(input);
+    return Outcome::kAccepted;
+  } catch (const harness::ProtocolError& e) {
+    lastError() = e.what();
+    return Outcome::kRejected;
+  }
+}
+
 struct Entry {
   Target target;
   Outcome (*contract)(const Body&, const std::string&);  // harnessParser or textParser
@@ -151,6 +163,9 @@ const std::vector<Entry>& entries() {
          write(file, t);
          harness::readPathCsv(file);
        }},
+      {{"planner_response", "an external planner's response line to request 1 (docs/PLANNER_PROTOCOL.md)"},
+       protocolParser,
+       [](const std::string& t) { harness::parsePlanResponse(t, 1); }},
       {{"movingai_map", "a MovingAI .map"},
        harnessParser,
        [](const std::string& t) {

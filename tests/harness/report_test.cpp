@@ -339,8 +339,10 @@ TEST(ReportBadInput, RowErrorsNameFileLineAndColumn) {
   EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column status: 'crashed' is not one of success, drifted, vo_lost"),
             std::string::npos);
   r = row("b");
-  r.planner = "astar";
-  EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column planner: 'astar'"), std::string::npos);
+  r.planner = "a*star";
+  EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column planner: 'a*star' is not one of proposed, agnostic, "
+                                      "rrtstar nor an external planner's name"),
+            std::string::npos);
   r = row("b");
   r.samples = "-3";
   EXPECT_NE(errorWithRow(dir, r).find("index.csv:3: column samples: '-3' is not an integer"), std::string::npos);

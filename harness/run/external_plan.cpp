@@ -1,0 +1,218 @@
+#include "harness/run/external_plan.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <system_error>
+#include <utility>
+
+#include "harness/base/child_process.h"
+#include "harness/base/errors.h"
+#include "harness/io/grid_io.h"
+#include "harness/io/planner_protocol.h"
+#include "harness/io/staged_output.h"
+#include "harness/run/given_route.h"
+#include "harness/run/plan_run.h"
+
+namespace tgnav::harness {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kShutdownGrace_s = 1.0;
+
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// A fresh folder under the system's temporary folder, removed with everything in it.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "tgnav-planner-XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) throw InputError("cannot create a temporary folder in " + pattern);
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// The topological classes (the AP planner's) as classes.json: index, length and path per class.
+planner::TopoPlan writeClasses(const Scenario& scenario, const planner::VoxelMap& voxels, std::uint64_t seed,
+                               const fs::path& file) {
+  const auto solver = planner::makePlanner(planner::PlannerKind::kAgnostic, voxels, scenario.planner.perception,
+                                           scenario.planner.rrt_star);
+  planner::Plan plan = solver->solve(planner::PlanRequest{scenario.scene.start, scenario.scene.goal, seed});
+  nlohmann::ordered_json classes = nlohmann::ordered_json::array();
+  const double z = scenario.scene.start.p_WB.z();
+  for (std::size_t k = 0; k < plan.topo.classes.size(); ++k) {
+    const planner::HomologyClass& c = plan.topo.classes[k];
+    nlohmann::ordered_json path = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < c.path.size(); ++i) {
+      const Eigen::Vector2d d =
+          c.path[std::min(i + 1, c.path.size() - 1)] - c.path[i > 0 && i + 1 == c.path.size() ? i - 1 : i];
+      path.push_back({c.path[i].x(), c.path[i].y(), z, std::atan2(d.y(), d.x())});
+    }
+    classes.push_back({{"index", k}, {"length_m", c.length_m}, {"path", path}});
+  }
+  writeFileAtomic(file, nlohmann::ordered_json{{"classes", classes}}.dump() + "\n");
+  return std::move(plan.topo);
+}
+
+PlanRequestMessage requestFor(const Scenario& scenario, const fs::path& map_dir, const fs::path& tmp,
+                              std::uint64_t seed, bool classes) {
+  const planner::PerceptionPlannerConfig& perception = scenario.planner.perception;
+  const planner::TrajectoryConfig& limits = scenario.planner.trajectory;
+  const ClearanceBand band = clearanceBand(scenario);
+  PlanRequestMessage m;
+  m.seed = seed;
+  m.time_budget_s = scenario.planner.external.timeout_s;
+  m.start = scenario.scene.start;
+  m.goal = scenario.scene.goal;
+  m.bounds_min_m = scenario.scene.bounds_min_m;
+  m.bounds_max_m = scenario.scene.bounds_max_m;
+  m.flight_height_m = scenario.scene.start.p_WB.z();
+  m.robot_radius_m = perception.robot_radius_m;
+  m.check_band_lo_m = band.lo_m;
+  m.check_band_hi_m = band.hi_m;
+  m.nominal_speed_m_s = limits.nominal_speed_mps;
+  m.max_speed_m_s = limits.max_speed_mps;
+  m.max_accel_m_s2 = limits.max_accel_mps2;
+  m.max_yaw_rate_rad_s = limits.max_yaw_rate_rad_s;
+  m.width_px = scenario.camera.width_px;
+  m.height_px = scenario.camera.height_px;
+  m.camera_rate_hz = scenario.trial.camera_rate_hz;
+  m.hfov_rad = perception.visibility.hfov_rad;
+  m.vfov_rad = perception.visibility.vfov_rad;
+  m.min_range_m = perception.visibility.min_range_m;
+  m.max_range_m = perception.visibility.max_range_m;
+  m.octomap = fs::absolute(map_dir / "map.bt").string();
+  m.landmarks = fs::absolute(map_dir / "landmarks.csv").string();
+  m.occupancy_yaml = (tmp / "occupancy.yaml").string();
+  m.occupancy_pgm = (tmp / "occupancy.pgm").string();
+  if (classes) m.classes = (tmp / "classes.json").string();
+  return m;
+}
+
+// Why a read or write ended without a line, with how the process ended when it did.
+std::string ioFailure(ChildProcess::Io io, ChildProcess* child, double budget_s) {
+  switch (io) {
+    case ChildProcess::Io::kTimeout: {
+      std::ostringstream s;
+      s << "no answer within " << budget_s << " s (planner.external.timeout_s)";
+      return s.str();
+    }
+    case ChildProcess::Io::kTooLong:
+      return "invalid response: a line longer than " + std::to_string(kMaxResponseBytes >> 20) + " MiB";
+    case ChildProcess::Io::kInterrupted:
+      return "interrupted";
+    default: {
+      const std::string ended = child->waitExit(kShutdownGrace_s);
+      return ended.empty() ? "closed its output" : ended + " before answering";
+    }
+  }
+}
+
+// The conversation: start, one request, one response, shutdown. Fills `out`; returns the failure
+// ("" when the response parsed).
+std::string converse(const Scenario& scenario, const PlanRequestMessage& request, const fs::path& tmp,
+                     const std::atomic<bool>* interrupt, ExternalPlan* out, PlanResponse* response) {
+  const ExternalPlannerConfig& ext = scenario.planner.external;
+  const fs::path err = tmp / "stderr.txt";
+  std::string failure;
+  const auto t_start = Clock::now();
+  const auto deadline =
+      t_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(ext.timeout_s));
+  try {
+    ChildProcess child(ext.command, ext.dir, err);
+    out->start_s = since(t_start);
+    const auto t_call = Clock::now();
+    ChildProcess::Io io = child.write(planRequestLine(request), deadline, interrupt);
+    std::string line;
+    if (io == ChildProcess::Io::kOk) io = child.readLine(&line, deadline, kMaxResponseBytes, interrupt);
+    if (io != ChildProcess::Io::kOk) {
+      failure = ioFailure(io, &child, ext.timeout_s);
+    } else {
+      try {
+        *response = parsePlanResponse(line, request.id);
+      } catch (const ProtocolError& e) {
+        failure = e.what();
+      }
+    }
+    out->call_s = since(t_call);
+    const auto t_stop = Clock::now();
+    (void)child.write(shutdownLine(), Clock::now() + std::chrono::milliseconds(100));
+    out->ended = child.stop(failure.empty() ? kShutdownGrace_s : 0.0);
+    out->stop_s = since(t_stop);
+  } catch (const std::runtime_error& e) {  // the system could not start it
+    failure = e.what();
+  }
+  out->stderr_tail = fileTail(err);
+  return failure;
+}
+
+}  // namespace
+
+ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_dir, const planner::VoxelMap& voxels,
+                                std::uint64_t seed, const std::atomic<bool>* interrupt) {
+  const ExternalPlannerConfig& ext = scenario.planner.external;
+  const std::string who = "external planner " + ext.name + ": ";
+  ExternalPlan out;
+  const TempDir tmp;
+  const auto t0 = Clock::now();
+  const ClearanceBand band = clearanceBand(scenario);
+  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp.path() / "occupancy.yaml", tmp.path() / "occupancy.pgm");
+  if (ext.classes) out.topo = writeClasses(scenario, voxels, seed, tmp.path() / "classes.json");
+  const PlanRequestMessage request = requestFor(scenario, map_dir, tmp.path(), seed, ext.classes);
+  out.prepare_s = since(t0);
+
+  PlanResponse response;
+  const std::string failure = converse(scenario, request, tmp.path(), interrupt, &out, &response);
+  if (!failure.empty()) {
+    out.detail = who + failure;
+    return out;
+  }
+  out.planner_s = response.solve_time_s;
+  out.reason = response.reason;
+  out.scores = response.scores;
+  out.homology_class = response.homology_class;
+  if (!response.ok) {
+    out.detail = who + "no path" + (response.reason.empty() ? std::string() : ": " + response.reason);
+    return out;
+  }
+  const auto classes = static_cast<int>(out.topo.classes.size());
+  if (ext.classes && response.homology_class && *response.homology_class >= classes) {
+    out.detail = who + "invalid response: homology_class " + std::to_string(*response.homology_class) +
+                 " is not one of the " + std::to_string(classes) + " classes sent";
+    return out;
+  }
+  const auto t_check = Clock::now();
+  try {
+    if (response.path) {
+      checkGivenPath(scenario, voxels, *response.path, "path");
+    } else {
+      checkGivenTrajectory(scenario, voxels, *response.trajectory, "trajectory");
+    }
+  } catch (const InputError& e) {
+    out.check_s = since(t_check);
+    out.detail = who + "route refused: " + e.what();
+    return out;
+  }
+  out.check_s = since(t_check);
+  out.path = std::move(response.path);
+  out.trajectory = std::move(response.trajectory);
+  out.ok = true;
+  return out;
+}
+
+}  // namespace tgnav::harness
