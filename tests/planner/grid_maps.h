@@ -254,6 +254,28 @@ inline std::string blocksMap(int w, int h, int n_blocks, std::uint32_t seed) {
   return detail::toMovingAi(rows);
 }
 
+// A warehouse: a regular grid of cols x rows rectangular shelves, each shelf_w x shelf_h cells,
+// `aisle` free cells between neighbouring shelves and `margin` free cells between the outer shelves
+// and the map's edge (the edge counts as obstacle). Like the MovingAI MAPF warehouse maps: with
+// one-cell aisles, every monotone route along the aisles has the same 4-connected length, so a
+// query has hundreds of near-equal homotopy classes. No randomness: the seed of the queries varies.
+inline std::string warehouseMap(int cols, int rows, int shelf_w, int shelf_h, int aisle, int margin) {
+  assert(cols >= 1 && rows >= 1 && shelf_w >= 1 && shelf_h >= 1 && aisle >= 1 && margin >= 1);
+  const int w = 2 * margin + cols * shelf_w + (cols - 1) * aisle;
+  const int h = 2 * margin + rows * shelf_h + (rows - 1) * aisle;
+  detail::Rows out(h, std::string(w, '.'));
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const int x0 = margin + c * (shelf_w + aisle);
+      const int y0 = margin + r * (shelf_h + aisle);
+      for (int y = y0; y < y0 + shelf_h; ++y) {
+        for (int x = x0; x < x0 + shelf_w; ++x) out[y][x] = '@';
+      }
+    }
+  }
+  return detail::toMovingAi(out);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Parsing.
 // ---------------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <iostream>
 #include <string>
 
@@ -89,6 +90,67 @@ TEST(GridMaps, EveryInflatedPathIsFoundClearAndNearTheOctileOptimum) {
     std::cout << "r " << r << ": " << tally.found << " found of " << tally.queries << " queries (" << tally.reachable
               << " reachable on the inflated 8-connected grid); worst shortest / optimum " << tally.worst_ratio << "\n";
     EXPECT_GE(tally.reachable, tally.queries / 2) << "the generators should give mostly reachable queries";
+  }
+}
+
+// Warehouse maps (issue 41): regular shelf grids where hundreds of homotopy classes have nearly the
+// same length. Far-apart queries (at least half the map's diagonal): the shortest class is always
+// among those returned, within 1.000x of the 8-connected optimum (an any-angle path is never
+// longer than the octile one).
+struct WarehouseCase {
+  std::string name;
+  int cols, rows, shelf_w, shelf_h, aisle, margin;
+};
+
+TEST(GridMaps, WarehouseShortestClassIsAlwaysReturned) {
+  const std::vector<WarehouseCase> cases = {
+      {"200-shelves-aisle1", 20, 10, 7, 2, 1, 2}, {"100-shelves-aisle1", 10, 10, 5, 1, 1, 2},
+      {"500-shelves-aisle1", 25, 20, 3, 2, 1, 2}, {"200-shelves-aisle2", 20, 10, 7, 2, 2, 2},
+      {"150-shelves-aisle3", 15, 10, 4, 3, 3, 3},
+  };
+  for (double r : {0.3, 0.0}) {
+    int queries = 0;
+    int diag_in_returned = 0;
+    double worst = 0.0;
+    for (const WarehouseCase& w : cases) {
+      const OccupancyGrid2D grid = testmaps::gridFromMovingAi(
+          testmaps::warehouseMap(w.cols, w.rows, w.shelf_w, w.shelf_h, w.aisle, w.margin), 1.0);
+      TopoPlannerConfig config;
+      config.robot_radius_m = r;
+      const TopologicalPlanner planner(grid, config);
+      const std::vector<std::uint8_t> free = testmaps::inflatedFreeMask(grid, r);
+      const double diagonal = std::hypot(grid.width, grid.height);
+      int used = 0;
+      for (const auto& [s, g] : testmaps::randomQueries(grid, 200, r, 11, true)) {
+        if ((s - g).cast<double>().norm() < 0.5 * diagonal || used >= 6) continue;
+        ++used;
+        ++queries;
+        const testmaps::Inflated8Path oracle = testmaps::inflated8Path(grid, free, s, g);
+        ASSERT_TRUE(oracle.found);
+        const Eigen::Vector2d start = grid.centreOf(s.x(), s.y());
+        const Eigen::Vector2d goal = grid.centreOf(g.x(), g.y());
+        const TopoPlan plan = planner.solve(start, goal);
+        const std::string where = w.name + " r " + std::to_string(r) + " (" + std::to_string(s.x()) + "," +
+                                  std::to_string(s.y()) + ") -> (" + std::to_string(g.x()) + "," +
+                                  std::to_string(g.y()) + ")";
+        ASSERT_EQ(plan.status, PlanStatus::kSolved) << where;
+        std::vector<Eigen::Vector2d> oracle_path;
+        for (const Eigen::Vector2i& c : oracle.cells) oracle_path.push_back(grid.centreOf(c.x(), c.y()));
+        const std::vector<double> sig = planner.hSignature(oracle_path);
+        bool in_returned = false;
+        for (const HomologyClass& c : plan.classes)
+          in_returned = in_returned || TopologicalPlanner::sameClass(c.h_signature, sig);
+        diag_in_returned += in_returned;
+        const double ratio = plan.classes.front().length_m / oracle.length_m;
+        worst = std::max(worst, ratio);
+        EXPECT_LE(ratio, 1.0 + 1e-9) << where << ": shortest class " << plan.classes.front().length_m
+                                     << " m, 8-connected " << oracle.length_m << " m; the optimum's class is "
+                                     << (in_returned ? "returned (shortening stopped short)" : "not returned");
+      }
+      EXPECT_GE(used, 3) << w.name;
+    }
+    std::cout << "warehouse r " << r << ": " << queries << " far-apart queries, the 8-connected optimum's class among "
+              << "those returned in " << diag_in_returned << "; worst shortest / optimum " << worst << "\n";
   }
 }
 
