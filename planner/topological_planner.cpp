@@ -612,6 +612,92 @@ bool TopologicalPlanner::keepClearance(std::vector<Eigen::Vector2d>* path) const
   return true;
 }
 
+std::vector<Eigen::Vector2d> TopologicalPlanner::freeSpaceShortest(const Eigen::Vector2d& start,
+                                                                   const Eigen::Vector2d& goal) const {
+  const OccupancyGrid2D& grid = field_.grid();
+  const Eigen::Vector2i s = grid.cellOf(start);
+  const Eigen::Vector2i t = grid.cellOf(goal);
+  auto free = [&](int x, int y) { return freeCell(x, y); };
+  if (!grid.inside(s.x(), s.y()) || !grid.inside(t.x(), t.y()) || !free(s.x(), s.y()) || !free(t.x(), t.y())) {
+    return {};
+  }
+  const double res = grid.resolution_m;
+  const double r = clearance_m_;
+  // A step is taken only where its segment keeps r: then the path found is clear as it stands.
+  // Each step of an 8-connected path through native cell centres lies on such a path's segment,
+  // so the optimum here is never longer than the native grid's.
+  auto clearStep = [&](int x, int y, int nx, int ny) {
+    const Eigen::Vector2d a = grid.centreOf(x, y);
+    const Eigen::Vector2d b = grid.centreOf(nx, ny);
+    const double half = 0.5 * (b - a).norm();
+    // Clearance is 1-Lipschitz: no point of the segment is farther than `half` from an end.
+    return std::min(field_.clearance(a), field_.clearance(b)) >= r + half || field_.segmentClear(a, b, r);
+  };
+  auto octile = [&](int i) {
+    const double dx = std::abs(i % grid.width - t.x());
+    const double dy = std::abs(i / grid.width - t.y());
+    return res * (std::max(dx, dy) + (std::sqrt(2.0) - 1.0) * std::min(dx, dy));
+  };
+  std::vector<double> cost(grid.occupied.size(), std::numeric_limits<double>::infinity());
+  std::vector<int> parent(grid.occupied.size(), -1);
+  using Item = std::pair<double, int>;  // f, cell
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  const int si = static_cast<int>(grid.index(s.x(), s.y()));
+  const int ti = static_cast<int>(grid.index(t.x(), t.y()));
+  cost[si] = 0.0;
+  open.emplace(octile(si), si);
+  while (!open.empty()) {
+    const auto [f, i] = open.top();
+    open.pop();
+    if (i == ti) break;
+    if (f > cost[i] + octile(i) + 1e-12) continue;
+    const int x = i % grid.width;
+    const int y = i / grid.width;
+    for (int k = 0; k < 8; ++k) {
+      if (!canStep(grid, free, x, y, k)) continue;
+      const int j = static_cast<int>(grid.index(x + kDx8[k], y + kDy8[k]));
+      const double nc = cost[i] + res * (k < 4 ? 1.0 : std::sqrt(2.0));
+      if (nc < cost[j] && clearStep(x, y, x + kDx8[k], y + kDy8[k])) {
+        cost[j] = nc;
+        parent[j] = i;
+        open.emplace(nc + octile(j), j);
+      }
+    }
+  }
+  if (!std::isfinite(cost[ti])) return {};
+  std::vector<Eigen::Vector2d> cells;
+  for (int i = ti; i >= 0; i = parent[i]) cells.push_back(grid.centreOf(i % grid.width, i / grid.width));
+  std::reverse(cells.begin(), cells.end());
+  // The exact ends, where they are not the cell centres: kept clear like any path.
+  cells.insert(cells.begin(), start);
+  cells.push_back(goal);
+  cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  std::vector<Eigen::Vector2d> found = cells;
+  const bool found_clear = keepClearance(&found);
+  std::vector<Eigen::Vector2d> shortened = shorten(cells);
+  const bool shortened_clear = keepClearance(&shortened);
+  if (shortened_clear && (!found_clear || polylineLength(shortened) <= polylineLength(found))) return shortened;
+  return found_clear ? found : std::vector<Eigen::Vector2d>{};
+}
+
+void TopologicalPlanner::ensureShortestClass(const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
+                                             TopoPlan* plan) const {
+  std::vector<Eigen::Vector2d> path = freeSpaceShortest(start, goal);
+  if (path.empty()) return;
+  HomologyClass shortest;
+  shortest.h_signature = hSignature(path);
+  shortest.length_m = polylineLength(path);
+  shortest.graph_path = path;
+  shortest.path = std::move(path);
+  for (HomologyClass& c : plan->classes) {
+    if (!sameClass(c.h_signature, shortest.h_signature)) continue;
+    if (shortest.length_m < c.length_m) c = std::move(shortest);
+    return;
+  }
+  if (static_cast<int>(plan->classes.size()) >= config_.max_classes) plan->classes.pop_back();
+  plan->classes.push_back(std::move(shortest));
+}
+
 TopoPlan TopologicalPlanner::solve(const Eigen::Vector2d& start, const Eigen::Vector2d& goal) const {
   TopoPlan plan;
   plan.gvd = skeleton_;
@@ -758,6 +844,10 @@ TopoPlan TopologicalPlanner::solve(const Eigen::Vector2d& start, const Eigen::Ve
     c.length_m = polylineLength(c.path);
     plan.classes.push_back(std::move(c));
   }
+  // The enumeration takes the first max_classes classes in order of their GVD length; with many
+  // near-equal ones (warehouse aisles) the shortest class can be left out, or its shortened path
+  // stop short of its own shortest. A search cut by max_expansions before any class stays cut.
+  if (!plan.classes.empty()) ensureShortestClass(start, goal, &plan);
   std::sort(plan.classes.begin(), plan.classes.end(),
             [](const HomologyClass& a, const HomologyClass& b) { return a.length_m < b.length_m; });
   if (plan.classes.empty()) {

@@ -100,6 +100,14 @@ class TopologicalPlanner {
   // skeleton cell seen along a clear segment, else the nearest reached through free cells.
   bool attach(const Eigen::Vector2d& p, Eigen::Vector2i* cell, std::vector<Eigen::Vector2d>* points) const;
   bool freeCell(int x, int y) const { return free_[field_.grid().index(x, y)] != 0; }
+  // The shortest 8-connected path from start to goal over the free working cells (A*, octile
+  // heuristic; diagonal steps need both side cells free), shortened within its class and kept
+  // clear, or as found when that is shorter; empty when there is none or it cannot be kept clear.
+  std::vector<Eigen::Vector2d> freeSpaceShortest(const Eigen::Vector2d& start, const Eigen::Vector2d& goal) const;
+  // Makes sure plan->classes holds the class of freeSpaceShortest() with a path no longer than it:
+  // replaces a longer path of that class, or adds the class (in place of the last one found when
+  // there are max_classes already).
+  void ensureShortestClass(const Eigen::Vector2d& start, const Eigen::Vector2d& goal, TopoPlan* plan) const;
 
   TopoPlannerConfig config_;
   int working_factor_ = 1;

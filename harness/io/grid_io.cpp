@@ -251,8 +251,9 @@ void writeRosMap(const planner::OccupancyGrid2D& grid, const std::filesystem::pa
   std::string image = "P5\n" + std::to_string(grid.width) + " " + std::to_string(grid.height) + "\n255\n";
   image.reserve(image.size() + grid.occupied.size());
   for (int row = 0; row < grid.height; ++row) {
-    for (int ix = 0; ix < grid.width; ++ix)
+    for (int ix = 0; ix < grid.width; ++ix) {
       image += static_cast<char>(grid.isOccupied(ix, grid.height - 1 - row) ? 0 : 254);
+    }
   }
   writeFileAtomic(pgm, image);
   std::ostringstream y;

@@ -60,11 +60,14 @@ void BM_TopologicalPlanGallery(benchmark::State& state) {
 BENCHMARK(BM_TopologicalPlanGallery)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // 0: game-like, 530 x 481 at 1 m, 160 building blocks; 1: 530 x 481 rooms of 12 cells with
-// one-cell doors; 2: a map_server-sized 2000 x 2000 at 0.05 m with 300 blocks. Robot radius 0.3 m.
+// one-cell doors; 2: a map_server-sized 2000 x 2000 at 0.05 m with 300 blocks; 3: a warehouse
+// like MovingAI's warehouse-10-20-10-2-1, 159 x 61 (161 x 63 with its border) at 1 m, 200 shelves
+// of 10 x 2 cells, one-cell aisles. Robot radius 0.3 m.
 planner::OccupancyGrid2D benchGrid(int kind) {
   using namespace planner::testmaps;
   if (kind == 0) return gridFromMovingAi(blocksMap(530, 481, 160, 1), 1.0);
   if (kind == 1) return gridFromMovingAi(roomsMap(530, 481, 12, 1), 1.0);
+  if (kind == 3) return gridFromMovingAi(warehouseMap(10, 20, 10, 2, 1, 25, 1), 1.0);
   return gridFromMovingAi(blocksMap(2000, 2000, 300, 1), 0.05);
 }
 
@@ -79,7 +82,14 @@ void BM_GridPreprocess(benchmark::State& state) {
   state.counters["cells"] = static_cast<double>(grid.width) * grid.height;
   state.counters["working_factor"] = k;
 }
-BENCHMARK(BM_GridPreprocess)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_GridPreprocess)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 // Ten random reachable queries per iteration on one preprocessed map: ms per query.
 void BM_GridQuery(benchmark::State& state) {
@@ -99,7 +109,7 @@ void BM_GridQuery(benchmark::State& state) {
                                                       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
   state.counters["solved"] = solved;
 }
-BENCHMARK(BM_GridQuery)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_GridQuery)->Arg(0)->Arg(1)->Arg(2)->Arg(3)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
 
 // Trajectory generation (B-spline position + yaw optimisation, checks) for the shortest gallery
 // class of at least 40 m, with the yaw along the direction of travel, at the default settings.

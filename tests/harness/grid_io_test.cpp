@@ -72,6 +72,19 @@ TEST_F(RosMap, BinaryPgmGivesExactCellsWithTopRowAtLargestY) {
   EXPECT_DOUBLE_EQ(grid.origin_m.y(), 2.0);
 }
 
+TEST_F(RosMap, WrittenMapReadsBackExactly) {
+  OccupancyGrid2D grid(5, 3, 0.1, Eigen::Vector2d(-1.25, 0.3));
+  grid.set(0, 0, true);
+  grid.set(4, 2, true);
+  grid.set(2, 1, true);
+  const auto dir = test::tempDir();
+  writeRosMap(grid, dir / "slice.yaml", dir / "slice.pgm");
+  const OccupancyGrid2D back = loadRosMap(dir / "slice.yaml");
+  EXPECT_EQ(drawn(back), (std::vector<std::string>{"....#", "..#..", "#...."}));
+  EXPECT_EQ(back.resolution_m, 0.1);
+  EXPECT_EQ(back.origin_m, Eigen::Vector2d(-1.25, 0.3));
+}
+
 TEST_F(RosMap, AsciiPgmScalesThresholdsWithMaxval) {
   // maxval 15: 15 free, 0 occupied, 8 (occ 0.47) unknown, 14 (occ 0.07) free.
   const auto file = write(kYaml + "mode: trinary\n", "P2\n# comment\n2 # inline comment\n2\n15\n15 0\n8 14\n");

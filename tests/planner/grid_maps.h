@@ -255,19 +255,20 @@ inline std::string blocksMap(int w, int h, int n_blocks, std::uint32_t seed) {
 }
 
 // A warehouse: a regular grid of cols x rows rectangular shelves, each shelf_w x shelf_h cells,
-// `aisle` free cells between neighbouring shelves and `margin` free cells between the outer shelves
-// and the map's edge (the edge counts as obstacle). Like the MovingAI MAPF warehouse maps: with
-// one-cell aisles, every monotone route along the aisles has the same 4-connected length, so a
-// query has hundreds of near-equal homotopy classes. No randomness: the seed of the queries varies.
-inline std::string warehouseMap(int cols, int rows, int shelf_w, int shelf_h, int aisle, int margin) {
-  assert(cols >= 1 && rows >= 1 && shelf_w >= 1 && shelf_h >= 1 && aisle >= 1 && margin >= 1);
-  const int w = 2 * margin + cols * shelf_w + (cols - 1) * aisle;
-  const int h = 2 * margin + rows * shelf_h + (rows - 1) * aisle;
+// `aisle` free cells between neighbouring shelves, and margin_x / margin_y free cells between the
+// outer shelves and the map's edge (which counts as obstacle). The MovingAI MAPF map
+// warehouse-10-20-10-2-1 is warehouseMap(10, 20, 10, 2, 1, 25, 1) inside its one-cell border: with
+// one-cell aisles, every monotone route through the shelves has the same 4-connected length, so a
+// far-apart query has hundreds of near-equal homotopy classes. No randomness: queries vary.
+inline std::string warehouseMap(int cols, int rows, int shelf_w, int shelf_h, int aisle, int margin_x, int margin_y) {
+  assert(cols >= 1 && rows >= 1 && shelf_w >= 1 && shelf_h >= 1 && aisle >= 1 && margin_x >= 1 && margin_y >= 1);
+  const int w = 2 * margin_x + cols * shelf_w + (cols - 1) * aisle;
+  const int h = 2 * margin_y + rows * shelf_h + (rows - 1) * aisle;
   detail::Rows out(h, std::string(w, '.'));
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
-      const int x0 = margin + c * (shelf_w + aisle);
-      const int y0 = margin + r * (shelf_h + aisle);
+      const int x0 = margin_x + c * (shelf_w + aisle);
+      const int y0 = margin_y + r * (shelf_h + aisle);
       for (int y = y0; y < y0 + shelf_h; ++y) {
         for (int x = x0; x < x0 + shelf_w; ++x) out[y][x] = '@';
       }

@@ -99,14 +99,14 @@ TEST(GridMaps, EveryInflatedPathIsFoundClearAndNearTheOctileOptimum) {
 // longer than the octile one).
 struct WarehouseCase {
   std::string name;
-  int cols, rows, shelf_w, shelf_h, aisle, margin;
+  int cols, rows, shelf_w, shelf_h, aisle, margin_x, margin_y;
 };
 
 TEST(GridMaps, WarehouseShortestClassIsAlwaysReturned) {
   const std::vector<WarehouseCase> cases = {
-      {"200-shelves-aisle1", 20, 10, 7, 2, 1, 2}, {"100-shelves-aisle1", 10, 10, 5, 1, 1, 2},
-      {"500-shelves-aisle1", 25, 20, 3, 2, 1, 2}, {"200-shelves-aisle2", 20, 10, 7, 2, 2, 2},
-      {"150-shelves-aisle3", 15, 10, 4, 3, 3, 3},
+      {"movingai-like-200", 10, 20, 10, 2, 1, 25, 1}, {"100-shelves", 10, 10, 10, 2, 1, 15, 1},
+      {"500-shelves", 20, 25, 5, 2, 1, 10, 2},        {"200-shelves-aisle2", 10, 20, 10, 2, 2, 25, 2},
+      {"150-shelves-aisle3", 10, 15, 6, 3, 3, 12, 3},
   };
   for (double r : {0.3, 0.0}) {
     int queries = 0;
@@ -114,7 +114,7 @@ TEST(GridMaps, WarehouseShortestClassIsAlwaysReturned) {
     double worst = 0.0;
     for (const WarehouseCase& w : cases) {
       const OccupancyGrid2D grid = testmaps::gridFromMovingAi(
-          testmaps::warehouseMap(w.cols, w.rows, w.shelf_w, w.shelf_h, w.aisle, w.margin), 1.0);
+          testmaps::warehouseMap(w.cols, w.rows, w.shelf_w, w.shelf_h, w.aisle, w.margin_x, w.margin_y), 1.0);
       TopoPlannerConfig config;
       config.robot_radius_m = r;
       const TopologicalPlanner planner(grid, config);
