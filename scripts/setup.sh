@@ -40,6 +40,7 @@ packages=(
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev  # OMPL's CMake links these
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-matplotlib                  # every figure (scripts/tgnav_plots.py)
+  python3-numpy                       # the example external planners (scripts/planners/)
   python3-sklearn python3-scipy       # the learned perception model (scripts/fit_track_model.py)
   clang-format-14                     # the style check (scripts/check_format.sh, CTest format.check)
   clang-14 libclang-rt-14-dev clang-tidy-14  # sanitizers, libFuzzer, clang-tidy (scripts/sanitize.sh, tidy.sh)

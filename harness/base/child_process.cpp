@@ -66,6 +66,11 @@ ChildProcess::ChildProcess(const std::string& command, const std::filesystem::pa
     systemError(stderr_file.string());
   }
   const std::string dir_text = dir.string();
+  // Everything the child needs, made before fork(): after it, only async-signal-safe calls.
+  std::string sh = "sh";
+  std::string dash_c = "-c";
+  std::string cmd = command;
+  char* argv[] = {sh.data(), dash_c.data(), cmd.data(), nullptr};
   const pid_t pid = fork();
   if (pid == 0) {  // the child: async-signal-safe calls only, up to exec
     setpgid(0, 0);
@@ -79,7 +84,7 @@ ChildProcess::ChildProcess(const std::string& command, const std::filesystem::pa
       (void)!::write(STDERR_FILENO, kMsg, sizeof kMsg - 1);
       _exit(126);
     }
-    execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    execve("/bin/sh", argv, environ);
     _exit(127);
   }
   const int fork_errno = errno;

@@ -32,6 +32,8 @@ class ChildProcess {
   ~ChildProcess();
   ChildProcess(const ChildProcess&) = delete;
   ChildProcess& operator=(const ChildProcess&) = delete;
+  ChildProcess(ChildProcess&&) = delete;
+  ChildProcess& operator=(ChildProcess&&) = delete;
 
   // Writes all of `text` to the child's stdin.
   Io write(const std::string& text, Clock::time_point deadline, const std::atomic<bool>* interrupt = nullptr);

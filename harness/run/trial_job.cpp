@@ -139,6 +139,23 @@ std::string voCsv(const TrialResult& r) {
   return out.str();
 }
 
+// The route fields every plan.json of a given or external route has: the smoothed trajectory's
+// report (when a path was smoothed) and the setpoints flown.
+void addRouteFields(const TrialResult& r, bool smoothed, nlohmann::ordered_json* plan) {
+  if (smoothed) {
+    const planner::TrajectoryReport& tr = r.plan.trajectory;
+    (*plan)["trajectory"] = {{"status", planner::toString(tr.status)},
+                             {"reason", tr.reason},
+                             {"duration_s", tr.duration_s},
+                             {"length_m", tr.length_m},
+                             {"min_clearance_m", tr.min_clearance_m}};
+  }
+  if (r.setpoints) {
+    (*plan)["setpoints"] = r.setpoints->setpoints().size();
+    (*plan)["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
+  }
+}
+
 // plan.json of a trial flown on an external planner's route: what it was asked, what it said and
 // how long the protocol took besides the planner's own time.
 nlohmann::ordered_json externalPlanJson(const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
@@ -177,18 +194,7 @@ nlohmann::ordered_json externalPlanJson(const Scenario& scenario, const TrialOpt
   ordered_json path = ordered_json::array();
   for (const planner::Pose4& p : r.plan.plan.path) path.push_back({p.p_WB.x(), p.p_WB.y(), p.p_WB.z(), p.yaw_rad});
   plan["path"] = path;
-  if (!r.plan.plan.path.empty()) {
-    const planner::TrajectoryReport& tr = r.plan.trajectory;
-    plan["trajectory"] = {{"status", planner::toString(tr.status)},
-                          {"reason", tr.reason},
-                          {"duration_s", tr.duration_s},
-                          {"length_m", tr.length_m},
-                          {"min_clearance_m", tr.min_clearance_m}};
-  }
-  if (r.setpoints) {
-    plan["setpoints"] = r.setpoints->setpoints().size();
-    plan["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
-  }
+  addRouteFields(r, !r.plan.plan.path.empty(), &plan);
   return plan;
 }
 
@@ -203,19 +209,8 @@ void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& 
     plan["seed"] = options.seed;
     plan["scenario"] = scenario.source.string();
     plan["scene"] = scenario.scene.source.string();
-    if (options.given_path) {
-      plan["waypoints"] = options.given_path->size();
-      const planner::TrajectoryReport& tr = r.plan.trajectory;
-      plan["trajectory"] = {{"status", planner::toString(tr.status)},
-                            {"reason", tr.reason},
-                            {"duration_s", tr.duration_s},
-                            {"length_m", tr.length_m},
-                            {"min_clearance_m", tr.min_clearance_m}};
-    }
-    if (r.setpoints) {
-      plan["setpoints"] = r.setpoints->setpoints().size();
-      plan["duration_s"] = r.setpoints->endTime() - r.setpoints->startTime();
-    }
+    if (options.given_path) plan["waypoints"] = options.given_path->size();
+    addRouteFields(r, options.given_path.has_value(), &plan);
     writeFileAtomic(d / "plan.json", plan.dump(2) + "\n");
   } else if (options.external) {
     const ExternalPlannerConfig& ext = scenario.planner.external;

@@ -138,8 +138,9 @@ TEST(GridMaps, WarehouseShortestClassIsAlwaysReturned) {
         for (const Eigen::Vector2i& c : oracle.cells) oracle_path.push_back(grid.centreOf(c.x(), c.y()));
         const std::vector<double> sig = planner.hSignature(oracle_path);
         bool in_returned = false;
-        for (const HomologyClass& c : plan.classes)
+        for (const HomologyClass& c : plan.classes) {
           in_returned = in_returned || TopologicalPlanner::sameClass(c.h_signature, sig);
+        }
         diag_in_returned += in_returned;
         const double ratio = plan.classes.front().length_m / oracle.length_m;
         worst = std::max(worst, ratio);
