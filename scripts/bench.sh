@@ -7,7 +7,9 @@
 # wall time, real-time factor, CPU seconds per simulated second of each stage and peak memory,
 # and the smoke sweep with --jobs 1 and --jobs 2
 # (results/bench/sweep-jobs*/) for the sweep throughput.
-# Figures are measured, never asserted. Usage: scripts/bench.sh [--benchmark_filter=REGEX]
+# Figures are measured, never asserted; the SHA is marked -dirty when tracked files had uncommitted
+# changes (build-bench is built from the working tree: do not edit sources while it builds).
+# Usage: scripts/bench.sh [--benchmark_filter=REGEX]
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 "$root/scripts/setup.sh"
@@ -87,6 +89,8 @@ for jobs in 1 2; do
 done
 
 sha=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+# Figures of uncommitted code say so (the binaries were built from the working tree as it was).
+if [ -n "$(git -C "$root" status --porcelain --untracked-files=no 2>/dev/null)" ]; then sha="$sha-dirty"; fi
 /usr/bin/python3 - "$out" "$sha" <<'PY'
 import json, os, socket, sys, datetime
 out, sha = sys.argv[1], sys.argv[2]
