@@ -672,6 +672,7 @@ std::vector<Eigen::Vector2d> TopologicalPlanner::freeSpaceShortest(const Eigen::
   cells.insert(cells.begin(), start);
   cells.push_back(goal);
   cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+  if (cells.size() < 2) return {};  // start == goal: the enumeration's own path stands
   std::vector<Eigen::Vector2d> found = cells;
   const bool found_clear = keepClearance(&found);
   std::vector<Eigen::Vector2d> shortened = shorten(cells);

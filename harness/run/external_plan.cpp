@@ -47,7 +47,8 @@ class TempDir {
   fs::path path_;
 };
 
-// The topological classes (the AP planner's) as classes.json: index, length and path per class.
+// The topological classes (the AP planner's) as classes.json: index, length and path per class
+// (every class path has at least its start and its goal).
 planner::TopoPlan writeClasses(const Scenario& scenario, const planner::VoxelMap& voxels, std::uint64_t seed,
                                const fs::path& file) {
   const auto solver = planner::makePlanner(planner::PlannerKind::kAgnostic, voxels, scenario.planner.perception,
@@ -59,8 +60,8 @@ planner::TopoPlan writeClasses(const Scenario& scenario, const planner::VoxelMap
     const planner::HomologyClass& c = plan.topo.classes[k];
     nlohmann::ordered_json path = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < c.path.size(); ++i) {
-      const Eigen::Vector2d d =
-          c.path[std::min(i + 1, c.path.size() - 1)] - c.path[i > 0 && i + 1 == c.path.size() ? i - 1 : i];
+      const std::size_t a = std::min(i, c.path.size() - 2);  // the segment leaving i (arriving, at the end)
+      const Eigen::Vector2d d = c.path[a + 1] - c.path[a];
       path.push_back({c.path[i].x(), c.path[i].y(), z, std::atan2(d.y(), d.x())});
     }
     classes.push_back({{"index", k}, {"length_m", c.length_m}, {"path", path}});
@@ -197,6 +198,7 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
     return out;
   }
   const auto t_check = Clock::now();
+  std::string refused;
   try {
     if (response.path) {
       checkGivenPath(scenario, voxels, *response.path, "path");
@@ -204,11 +206,13 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
       checkGivenTrajectory(scenario, voxels, *response.trajectory, "trajectory");
     }
   } catch (const InputError& e) {
-    out.check_s = since(t_check);
-    out.detail = who + "route refused: " + e.what();
-    return out;
+    refused = e.what();
   }
   out.check_s = since(t_check);
+  if (!refused.empty()) {
+    out.detail = who + "route refused: " + refused;
+    return out;
+  }
   out.path = std::move(response.path);
   out.trajectory = std::move(response.trajectory);
   out.ok = true;

@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "harness/base/errors.h"
@@ -45,6 +48,17 @@ inline std::filesystem::path writeFile(const std::filesystem::path& path, const 
 inline std::filesystem::path smokeScenario(const std::filesystem::path& dir, const std::string& body) {
   return writeFile(dir / "scenario.yaml",
                    "scene: " + (sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n" + body);
+}
+
+// DIR/metrics.json as text to compare, without its wall-clock figures (plan_time_s, wall_time_s,
+// real_time_factor, peak_rss_mb, timing) and the keys in `also`.
+inline std::string metricsWithout(const std::filesystem::path& dir, std::initializer_list<const char*> also = {}) {
+  std::ifstream in(dir / "metrics.json");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
+  for (const char* key : {"plan_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb", "timing"}) j.erase(key);
+  for (const char* key : also) j.erase(key);
+  return j.dump(2);
 }
 
 // Runs a shell command line; its output (stderr included) and exit code.

@@ -77,13 +77,7 @@ std::map<std::string, std::string> readIndex(const fs::path& sweep_dir) {
 }
 
 // metrics.json without its wall-clock figures.
-std::string deterministicMetrics(const fs::path& trial) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(readText(trial / "metrics.json"));
-  for (const char* key : {"plan_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb", "timing", "scenario"}) {
-    j.erase(key);
-  }
-  return j.dump(2);
-}
+std::string deterministicMetrics(const fs::path& trial) { return test::metricsWithout(trial, {"scenario"}); }
 
 void expectSameResults(const fs::path& a, const fs::path& b) {
   const auto ia = readIndex(a);

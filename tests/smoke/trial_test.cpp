@@ -40,11 +40,7 @@ std::string readText(const std::filesystem::path& file) {
 nlohmann::json readJson(const std::filesystem::path& file) { return nlohmann::json::parse(readText(file)); }
 
 // metrics.json without its wall-clock figures.
-std::string deterministicMetrics(const std::filesystem::path& dir) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(readText(dir / "metrics.json"));
-  for (const char* key : {"plan_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb", "timing"}) j.erase(key);
-  return j.dump(2);
-}
+std::string deterministicMetrics(const std::filesystem::path& dir) { return test::metricsWithout(dir); }
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
@@ -258,13 +254,9 @@ TEST(SmokeTrialCli, GivenTrajectoryFliesAsThePlannedOne) {
             std::string::npos)
       << given.output;
   auto comparable = [&](const char* run) {
-    nlohmann::ordered_json j = nlohmann::ordered_json::parse(readText(dir / run / "metrics.json"));
-    for (const char* key :
-         {"plan_time_s", "wall_time_s", "real_time_factor", "peak_rss_mb", "timing", "planner", "given_file", "classes",
-          "chosen_class", "c_p_min", "plan_status", "planned_length_m", "trajectory_length_m", "trajectory_status"}) {
-      j.erase(key);
-    }
-    return j.dump(2);
+    return test::metricsWithout(
+        dir / run, {"planner", "given_file", "classes", "chosen_class", "c_p_min", "plan_status", "planned_length_m",
+                    "trajectory_length_m", "trajectory_status"});
   };
   EXPECT_EQ(comparable("planned"), comparable("given"));
   for (const char* f : {"vo.csv", "gt.tum", "est.tum", "trajectory.csv"}) {
