@@ -113,10 +113,11 @@ case "$mode" in
     build_fuzz "$dir"
     # Left out at sanitizer speed (10-20x slower there, 18 of 27 minutes of test time), each for a
     # smaller test or the smoke runs below that go through the same code: the property tests over
-    # many random maps (TrajectoryGrid, GridMaps: the other planner tests plan on the same code),
+    # many random maps and warehouse grids (TrajectoryGrid, GridMaps: the other planner tests plan
+    # on the same code; the warehouse test alone took 150 s here),
     # RRT*'s 15000-sample route test, the smoke-map tests (five map builds; the smoke trial below
     # builds one), and the sweep runner's Slurm and resume tests (the smoke sweep below).
-    slow='TrajectoryGrid\.RandomMaps|GridMaps\.EveryInflatedPath|PerceptionRrtStar\.TakesTheLongerTexturedRoute'
+    slow='TrajectoryGrid\.RandomMaps|GridMaps\.(EveryInflatedPath|Warehouse)|PerceptionRrtStar\.TakesTheLongerTexturedRoute'
     slow+='|SmokeMapTest\.|SweepRunner\.(SlurmBackend|LocalRunResumes)'
     # And one test for a runtime bug: an image no decoder reads makes OpenCV load GDAL's plugins,
     # whose thread-local storage crashed LeakSanitizer's tracer at exit on every run on the

@@ -28,10 +28,12 @@ double number(const json& v, const std::string& where) {
 std::vector<std::vector<double>> rows(const json& v, const std::string& key, std::size_t min, std::size_t max,
                                       const std::vector<std::size_t>& widths) {
   if (!v.is_array()) invalid("'" + key + "' is not an array");
-  if (v.size() < min)
+  if (v.size() < min) {
     invalid("'" + key + "' has " + std::to_string(v.size()) + " points, at least " + std::to_string(min) + " needed");
-  if (v.size() > max)
+  }
+  if (v.size() > max) {
     invalid("'" + key + "' has " + std::to_string(v.size()) + " points, at most " + std::to_string(max) + " allowed");
+  }
   std::vector<std::vector<double>> out;
   out.reserve(v.size());
   std::size_t width = 0;
