@@ -193,6 +193,7 @@ void BundleAdjustmentConfig::validate() const {
   require(max_iterations >= 1, "ba.max_iterations", max_iterations, "must be >= 1");
   require(fixed_keyframes >= 1, "ba.fixed_keyframes", fixed_keyframes, "must be >= 1 (the gauge)");
   require(latency_frames >= 0 && latency_frames <= 100, "ba.latency_frames", latency_frames, "must be in [0, 100]");
+  require(every_keyframes >= 1 && every_keyframes <= 100, "ba.every_keyframes", every_keyframes, "must be in [1, 100]");
 }
 
 BaReport bundleAdjust(BaProblem* problem, const CameraIntrinsics& camera, const BundleAdjustmentConfig& config) {

@@ -63,6 +63,8 @@ struct BundleAdjustmentConfig {
                                      // held fixed in the window (the gauge)
   int latency_frames = 0;            // RgbdOdometry: 0 adjusts at the keyframe; L > 0 solves on a
                                      // thread of its own and applies the result L frames later
+  int every_keyframes = 1;           // RgbdOdometry: adjust at every N-th keyframe (the window then
+                                     // holds the N new ones)
 
   template <typename Archive>
   void visit(Archive& a) {
@@ -74,6 +76,7 @@ struct BundleAdjustmentConfig {
     a("max_iterations", max_iterations);
     a("fixed_keyframes", fixed_keyframes);
     a("latency_frames", latency_frames);
+    a("every_keyframes", every_keyframes);
   }
 
   void validate() const;  // std::invalid_argument naming the field (within ba) and value

@@ -89,6 +89,29 @@ TEST(Odometry, BundleAdjustmentRefinesKeyframesOnly) {
   }
 }
 
+// ba.every_keyframes = 3: the adjustment runs at every third keyframe after the first, and the
+// slide is tracked as well as with one at each.
+TEST(Odometry, BundleAdjustmentAtEveryNthKeyframe) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  OdometryConfig config;
+  config.ba.every_keyframes = 3;
+  RgbdOdometry vo(camera(), config);
+  int keyframes = 0;
+  int adjusted = 0;
+  for (int i = 0; i < 100; ++i) {
+    const FrameResult r = vo.track(0.05 * i, tex(cv::Rect(4 * i, 0, kW, kH)).clone(), flatDepth());
+    ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+    const double truth = 4.0 * i * kDepth / kF;
+    EXPECT_NEAR(r.X_WC.translation().x(), truth, 0.01 * truth + 8e-3) << "frame " << i;
+    if (r.keyframe && i > 0) ++keyframes;
+    const bool lands = std::isfinite(r.ba_correction_m);
+    EXPECT_EQ(lands, r.keyframe && i > 0 && keyframes % 3 == 0) << "frame " << i << ", keyframe " << keyframes;
+    adjusted += lands ? 1 : 0;
+  }
+  EXPECT_GE(keyframes, 6);
+  EXPECT_EQ(adjusted, keyframes / 3);
+}
+
 // Bundle adjustment in the background (ba.latency_frames = 3): each adjustment is applied 3
 // frames after the keyframe that started it, or after the frame that applied the one before
 // (one in flight at a time); the run tracks the slide as well as adjusting at the keyframe, and
@@ -285,6 +308,9 @@ TEST(Odometry, BadFramesAndConfigsAreRefused) {
   c = OdometryConfig{};
   c.ba.robust_iterations = 0;
   EXPECT_NE(message(c).find("ba.robust_iterations = 0"), std::string::npos);
+  c = OdometryConfig{};
+  c.ba.every_keyframes = 0;
+  EXPECT_NE(message(c).find("ba.every_keyframes = 0"), std::string::npos);
   EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
 }
 
