@@ -327,8 +327,8 @@ void RgbdOdometry::applyBundleAdjustment(BaJob& job, FrameResult* result) {
 // At a keyframe: adjust now (latency 0), or start an adjustment on its own thread, or, while one
 // is in flight, queue the request for when that one is applied.
 void RgbdOdometry::adjustAfterKeyframe(FrameResult* result) {
-  if (++keyframes_unadjusted_ < config_.ba.every_keyframes) return;
-  keyframes_unadjusted_ = 0;
+  // keyframes_since_init_ counts the first keyframe too: this is the k-th after it.
+  if ((keyframes_since_init_ - 1) % config_.ba.every_keyframes != 0) return;
   if (config_.ba.latency_frames == 0) {
     if (std::unique_ptr<BaJob> job = startBundleAdjustment()) applyBundleAdjustment(*job, result);
     return;

@@ -381,7 +381,6 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const PreparedFrame& fr
   keyframes_.clear();
   retired_.clear();
   keyframes_since_init_ = 0;
-  keyframes_unadjusted_ = 0;
   addKeyframe(X_WC_, frame, std::vector<int>(frame.features.keypoints.size(), -1), 0);
   result.X_WC = X_WC_;
   result.status = TrackingStatus::kOk;

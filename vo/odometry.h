@@ -277,7 +277,6 @@ class RgbdOdometry {
   long next_landmark_id_ = 0;
   long frame_ = 0;  // frames tracked
   int keyframes_since_init_ = 0;
-  int keyframes_unadjusted_ = 0;  // keyframes since the last adjustment (ba.every_keyframes)
   long last_keyframe_frame_ = 0;
   std::unique_ptr<BaJob> ba_job_;  // the bundle adjustment in flight (ba.latency_frames > 0)
   bool ba_queued_ = false;         // a keyframe came while it was: adjust again once it is applied
