@@ -63,7 +63,7 @@ struct BundleAdjustmentConfig {
                                      // held fixed in the window (the gauge)
   int latency_frames = 0;            // RgbdOdometry: 0 adjusts at the keyframe; L > 0 solves on a
                                      // thread of its own and applies the result L frames later
-  int every_keyframes = 1;           // RgbdOdometry: adjust at every N-th keyframe (with N up to
+  int every_keyframes = 3;           // RgbdOdometry: adjust at every N-th keyframe (with N up to
                                      // local_map_keyframes the window holds the N new ones)
 
   template <typename Archive>

@@ -75,7 +75,7 @@ struct OdometryConfig {
   int ransac_iterations = 200;
   double ransac_confidence = 0.995;
   int local_map_keyframes = 5;          // keyframes whose landmarks form the local map
-  double keyframe_inlier_ratio = 0.6;   // new keyframe when tracked landmarks fall below this
+  double keyframe_inlier_ratio = 0.7;   // new keyframe when tracked landmarks fall below this
                                         // fraction of the last keyframe's
   double keyframe_translation_m = 0.4;  // ... or the camera moved this far
   double keyframe_rotation_rad = 0.35;  // ... or turned this much

@@ -58,14 +58,15 @@ TEST(Odometry, TracksASidewaysSlideOverATexturedPlane) {
   EXPECT_GT(vo.history().back().features, 500);
 }
 
-// Bundle adjustment runs on keyframes (not on the first, which has nothing to adjust against)
-// and reports what it changed there; with ba.enabled = false nothing is reported. Both track the
-// slide; on exact depth BA's corrections are small.
+// Bundle adjustment runs on keyframes (at each with ba.every_keyframes = 1; not on the first,
+// which has nothing to adjust against) and reports what it changed there; with ba.enabled =
+// false nothing is reported. Both track the slide; on exact depth BA's corrections are small.
 TEST(Odometry, BundleAdjustmentRefinesKeyframesOnly) {
   const cv::Mat tex = texture(kW + 400, kH);
   for (const bool ba : {true, false}) {
     OdometryConfig config;
     config.ba.enabled = ba;
+    config.ba.every_keyframes = 1;
     RgbdOdometry vo(camera(), config);
     int adjusted = 0;
     for (int i = 0; i < 100; ++i) {
@@ -121,6 +122,7 @@ TEST(Odometry, BackgroundBundleAdjustmentLandsAFixedNumberOfFramesLater) {
   const cv::Mat tex = texture(kW + 400, kH);
   OdometryConfig config;
   config.ba.latency_frames = 3;
+  config.ba.every_keyframes = 1;
   std::vector<std::vector<FrameResult>> runs;
   for (int run = 0; run < 2; ++run) {
     RgbdOdometry vo(camera(), config);
