@@ -11,8 +11,9 @@ namespace tgnav::planner {
 
 namespace {
 
-const int kDx8[8] = {1, 1, 0, -1, -1, -1, 0, 1};
-const int kDy8[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+// The 8 neighbours in ring order (counter-clockwise from +x).
+const int kRingDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+const int kRingDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 
 struct Mask {
   int w, h;
@@ -21,7 +22,7 @@ struct Mask {
   void set(int x, int y, bool v) { m[static_cast<std::size_t>(y) * w + x] = v ? 1 : 0; }
   int neighbours(int x, int y) const {
     int n = 0;
-    for (int k = 0; k < 8; ++k) n += at(x + kDx8[k], y + kDy8[k]);
+    for (int k = 0; k < 8; ++k) n += at(x + kRingDx[k], y + kRingDy[k]);
     return n;
   }
 };
@@ -81,7 +82,7 @@ void pruneSpurs(Mask& mask, double min_length_cells) {
           Eigen::Vector2i next(-1, -1);
           int count = 0;
           for (int k = 0; k < 8; ++k) {
-            const Eigen::Vector2i c(cur.x() + kDx8[k], cur.y() + kDy8[k]);
+            const Eigen::Vector2i c(cur.x() + kRingDx[k], cur.y() + kRingDy[k]);
             if (!mask.at(c.x(), c.y()) || c == prev) continue;
             if (std::find(branch.begin(), branch.end(), c) != branch.end()) continue;
             ++count;
@@ -182,8 +183,8 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
     cluster[grid.index(x0, y0)] = id;
     for (std::size_t i = 0; i < cells.size(); ++i) {
       for (int k = 0; k < 8; ++k) {
-        const int nx = cells[i].x() + kDx8[k];
-        const int ny = cells[i].y() + kDy8[k];
+        const int nx = cells[i].x() + kRingDx[k];
+        const int ny = cells[i].y() + kRingDy[k];
         if (!mask.at(nx, ny) || !is_vertex_cell[grid.index(nx, ny)] || cluster[grid.index(nx, ny)] >= 0) continue;
         cluster[grid.index(nx, ny)] = id;
         cells.emplace_back(nx, ny);
@@ -226,8 +227,8 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
       const int x = static_cast<int>(queue[q] % grid.width);
       const int y = static_cast<int>(queue[q] / grid.width);
       for (int k = 0; k < 8; ++k) {
-        const int nx = x + kDx8[k];
-        const int ny = y + kDy8[k];
+        const int nx = x + kRingDx[k];
+        const int ny = y + kRingDy[k];
         if (!mask.at(nx, ny)) continue;
         const std::size_t j = grid.index(nx, ny);
         if (cluster[j] != id || cluster_parent[j] >= 0) continue;
@@ -258,7 +259,7 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
       Eigen::Vector2i end_cell(-1, -1);
       Eigen::Vector2i next(-1, -1);
       for (int k = 0; k < 8 && end_vertex < 0; ++k) {
-        const Eigen::Vector2i c(cur.x() + kDx8[k], cur.y() + kDy8[k]);
+        const Eigen::Vector2i c(cur.x() + kRingDx[k], cur.y() + kRingDy[k]);
         if (!mask.at(c.x(), c.y()) || c == prev) continue;
         const int v = cluster[grid.index(c.x(), c.y())];
         if (v >= 0 && !(v == from && chain.size() < 3)) {
@@ -290,7 +291,7 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
       // Continue along the chain: prefer 4-neighbours (the diagonal is a shortcut of the same line).
       for (int pass = 0; pass < 2 && next.x() < 0; ++pass) {
         for (int k = pass; k < 8; k += 2) {
-          const Eigen::Vector2i c(cur.x() + kDx8[k], cur.y() + kDy8[k]);
+          const Eigen::Vector2i c(cur.x() + kRingDx[k], cur.y() + kRingDy[k]);
           if (!mask.at(c.x(), c.y()) || visited[grid.index(c.x(), c.y())] || cluster[grid.index(c.x(), c.y())] >= 0) {
             continue;
           }
@@ -311,7 +312,7 @@ TopoGraph buildTopoGraph(const DistanceField& field, const std::vector<std::uint
         const int v = cluster[grid.index(x, y)];
         if (v < static_cast<int>(first_vertex)) continue;
         for (int k = 0; k < 8; ++k) {
-          const Eigen::Vector2i c(x + kDx8[k], y + kDy8[k]);
+          const Eigen::Vector2i c(x + kRingDx[k], y + kRingDy[k]);
           if (!mask.at(c.x(), c.y()) || visited[grid.index(c.x(), c.y())] || cluster[grid.index(c.x(), c.y())] >= 0) {
             continue;
           }

@@ -13,7 +13,8 @@
 # Only the targets that run are built (-O1 -g1, about 10 minutes on 2 cores). Findings are fatal
 # (-fno-sanitize-recover=all). Suppressions: scripts/sanitize/*.supp, third-party code only.
 # Fuzzing keeps a corpus in build-sanitize/fuzz/corpus/<target> that grows from run to run, and
-# adds each run's seconds and executions to build-sanitize/fuzz/totals.csv; a crash stops it with
+# adds each run's seconds and executions to build-sanitize/fuzz/totals.csv (targets run nproc at a
+# time); a crash fails the run once every target has had its time, with
 # the input in build-sanitize/fuzz/crashes/<target>/: once fixed, add the input to
 # tests/fuzz/regressions/<target>/, where the replay test keeps it fixed.
 set -euo pipefail
@@ -27,12 +28,17 @@ export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1:suppressions=$supp/ubsan.supp"
 export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/tsan.supp"
 
+# A unity build (CMake joins each library's sources 8 at a time): the headers (Eigen, OpenCV,
+# yaml-cpp) are parsed and their templates compiled once per 8 files, not per file; the libraries
+# then build in about a third of the time. The normal build is not a unity build, so each source
+# still compiles on its own there; clang-tidy (scripts/tidy.sh) reads build-tidy/'s per-file commands.
 configure() {  # configure DIR SANITIZERS [cmake args...]
   local dir=$1 sanitizers=$2
   shift 2
   if [[ ! -f "$dir/CMakeCache.txt" ]]; then
     CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" \
-      -DTGNAV_SANITIZE="$sanitizers" -DTGNAV_BUILD_BENCHMARKS=OFF "$@" >/dev/null
+      -DTGNAV_SANITIZE="$sanitizers" -DTGNAV_BUILD_BENCHMARKS=OFF -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8 \
+      "$@" >/dev/null
   fi
 }
 
@@ -83,15 +89,34 @@ fuzz() {  # fuzz DIR SECONDS [TARGET...]
   [[ -f "$work/totals.csv" ]] || echo "target,seconds,executions,commit" >"$work/totals.csv"
   local commit
   commit=$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo unknown)
+  # The targets run $jobs at a time (each is one process on one core); each writes its log and
+  # exit status, and the results are read in the list's order once all have stopped.
+  local t running=0
   for t in "${names[@]}"; do
     mkdir -p "$work/corpus/$t" "$work/crashes/$t"
-    local log="$work/$t.log"
+    rm -f "$work/$t.status"
     # -rss_limit_mb: a parser must not need more than this for any input; -timeout: nor this long.
-    if ! "$dir/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 \
-      -artifact_prefix="$work/crashes/$t/" "$work/corpus/$t" "$work/seeds/$t" >"$log" 2>&1; then
+    (
+      status=0
+      "$dir/tests/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 -print_final_stats=1 \
+        -artifact_prefix="$work/crashes/$t/" "$work/corpus/$t" "$work/seeds/$t" >"$work/$t.log" 2>&1 || status=$?
+      echo "$status" >"$work/$t.status"
+    ) &
+    running=$((running + 1))
+    if ((running >= jobs)); then
+      wait -n || true
+      running=$((running - 1))
+    fi
+  done
+  wait || true
+  local failed=0
+  for t in "${names[@]}"; do
+    local log="$work/$t.log"
+    if [[ "$(cat "$work/$t.status" 2>/dev/null)" != 0 ]]; then
       tail -n 40 "$log" >&2
       echo "sanitize.sh: fuzz target $t failed; the input is in $work/crashes/$t/ (log: $log)" >&2
-      exit 1
+      failed=1
+      continue
     fi
     local execs
     execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
@@ -99,6 +124,7 @@ fuzz() {  # fuzz DIR SECONDS [TARGET...]
     printf 'fuzz %-15s %4ds %10s executions, corpus %s inputs\n' "$t" "$seconds" "${execs:-0}" \
       "$(find "$work/corpus/$t" -type f | wc -l)"
   done
+  ((failed == 0)) || exit 1
 }
 
 case "$mode" in

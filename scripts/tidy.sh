@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # clang-tidy-14 with the repository's .clang-tidy over the project's own sources (planner/,
 # control/, vo/, harness/; their headers through HeaderFilterRegex), using the compile commands of
-# build-sanitize/ (Clang; configured here when missing, nothing is built). Prints the findings and
-# exits 1 when there is any. CI runs it (about 7 minutes on 2 cores).
+# build-tidy/ (Clang with the sanitizer build's flags, but one command per source file, where
+# build-sanitize/ is a unity build; configured here when missing, nothing is built). Prints the
+# findings and exits 1 when there is any. CI runs it (about 10 minutes on 2 cores).
 #
 #   scripts/tidy.sh [FILE...]     all sources, or the files named
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-dir="$root/build-sanitize"
+dir="$root/build-tidy"
 if [[ ! -f "$dir/compile_commands.json" ]]; then
   CC=clang-14 CXX=clang++-14 cmake -S "$root" -B "$dir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" \
     -DTGNAV_SANITIZE=address,undefined -DTGNAV_FUZZ=ON -DTGNAV_BUILD_TESTS=ON >/dev/null

@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/base/shell.h"
 
@@ -42,8 +43,6 @@ std::string formatDuration(double s) {
 }
 
 namespace {
-
-double secondsSince(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 std::atomic<int> g_signal{0};
 extern "C" void onSweepSignal(int sig) { g_signal.store(sig); }

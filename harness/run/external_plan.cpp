@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "harness/base/child_process.h"
+#include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/io/grid_io.h"
 #include "harness/io/planner_protocol.h"
@@ -24,8 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kShutdownGrace_s = 1.0;
-
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // A fresh folder under the system's temporary folder, removed with everything in it.
 class TempDir {
@@ -138,7 +137,7 @@ std::string converse(const Scenario& scenario, const PlanRequestMessage& request
       t_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(ext.timeout_s));
   try {
     ChildProcess child(ext.command, ext.dir, err);
-    out->start_s = since(t_start);
+    out->start_s = secondsSince(t_start);
     const auto t_call = Clock::now();
     ChildProcess::Io io = child.write(planRequestLine(request), deadline, interrupt);
     std::string line;
@@ -152,11 +151,11 @@ std::string converse(const Scenario& scenario, const PlanRequestMessage& request
         failure = e.what();
       }
     }
-    out->call_s = since(t_call);
+    out->call_s = secondsSince(t_call);
     const auto t_stop = Clock::now();
     (void)child.write(shutdownLine(), Clock::now() + std::chrono::milliseconds(100));
     out->ended = child.stop(failure.empty() ? kShutdownGrace_s : 0.0);
-    out->stop_s = since(t_stop);
+    out->stop_s = secondsSince(t_stop);
   } catch (const std::runtime_error& e) {  // the system could not start it
     failure = e.what();
   }
@@ -177,7 +176,7 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
   writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp.path() / "occupancy.yaml", tmp.path() / "occupancy.pgm");
   if (ext.classes) out.topo = writeClasses(scenario, voxels, seed, tmp.path() / "classes.json");
   const PlanRequestMessage request = requestFor(scenario, map_dir, tmp.path(), seed, ext.classes);
-  out.prepare_s = since(t0);
+  out.prepare_s = secondsSince(t0);
 
   PlanResponse response;
   const std::string failure = converse(scenario, request, tmp.path(), interrupt, &out, &response);
@@ -210,7 +209,7 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
   } catch (const InputError& e) {
     refused = e.what();
   }
-  out.check_s = since(t_check);
+  out.check_s = secondsSince(t_check);
   if (!refused.empty()) {
     out.detail = who + "route refused: " + refused;
     return out;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/base/ordered_worker.h"
 #include "harness/sim/camera.h"
@@ -29,7 +30,6 @@ constexpr std::size_t kSurveyQueueFrames = 4;
 // Every survey frame's depth is kept at every kViewStridePx-th pixel (in millimetres) to count
 // each landmark's opportunities once all landmarks are known (9.6 MB per 1000 frames at 640x480).
 constexpr int kViewStridePx = 8;
-double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
 // A landmark being accumulated over observations.
 struct Track {
@@ -291,17 +291,17 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   OrderedWorker<RgbdFrame> integrator(kSurveyQueueFrames, [&](RgbdFrame& frame) {
     Clock::time_point t0 = Clock::now();
     insertDepth(frame, k, config, &map.occupancy());
-    stats.integrate_s += since(t0);
+    stats.integrate_s += secondsSince(t0);
     t0 = Clock::now();
     observeFeatures(frame, k, config, detector, &associator, &stats);
     views.push_back(keepView(frame));
-    stats.features_s += since(t0);
+    stats.features_s += secondsSince(t0);
   });
   for (std::size_t f = 0; f < poses.size(); ++f) {
     const Clock::time_point t0 = Clock::now();
     setVehiclePose(model.get(), data.get(), ids, poses[f]);
     RgbdFrame frame = camera.render(data.get());
-    stats.render_s += since(t0);
+    stats.render_s += secondsSince(t0);
     integrator.submit(std::move(frame));
     ++stats.frames;
     if (progress) progress(static_cast<int>(f + 1), static_cast<int>(poses.size()));
@@ -311,14 +311,14 @@ planner::FeatureMap buildFeatureMap(const SceneConfig& scene, const MapBuildConf
   std::vector<planner::Landmark> landmarks = keptLandmarks(associator, config.min_observations, &stats);
   const Clock::time_point t_opportunities = Clock::now();
   countOpportunities(views, k, config, &landmarks);
-  stats.opportunities_s = since(t_opportunities);
+  stats.opportunities_s = secondsSince(t_opportunities);
   map.setLandmarks(std::move(landmarks));
   stats.landmarks_merged = static_cast<int>(associator.tracks().size());
   stats.dropped_not_embedded = map.embedLandmarks(config.max_shift_m);
   stats.landmarks = static_cast<int>(map.landmarks().size());
   for (const planner::Landmark& lm : map.landmarks()) stats.mean_detectability += lm.detectability();
   if (stats.landmarks > 0) stats.mean_detectability /= stats.landmarks;
-  stats.total_s = since(t_start);
+  stats.total_s = secondsSince(t_start);
   if (stats_out != nullptr) *stats_out = stats;
   return map;
 }

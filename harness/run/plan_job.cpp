@@ -7,6 +7,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/config/scenario.h"
 #include "harness/config/values.h"
@@ -71,10 +72,6 @@ MapLayer gridLayer(const planner::OccupancyGrid2D& grid, const planner::TopoPlan
   layer.legend = {
       {"occupied", cv::Vec3b(70, 70, 70)}, {"free", cv::Vec3b(255, 255, 255)}, {"GVD", cv::Vec3b(150, 200, 235)}};
   return layer;
-}
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 planner::TopoPlannerConfig gridPlannerConfig(double robot_radius_m, int max_classes) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "planner/perception_planner.h"
 #include "planner/rrt_star.h"
@@ -13,10 +14,6 @@ namespace tgnav::harness {
 namespace {
 
 constexpr double kBoxMargin_m = 0.5;
-
-double since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
@@ -49,7 +46,7 @@ void smoothPath(const Scenario& scenario, const std::vector<planner::Pose4>& pat
   request.obstacle_points = obstacle_points;
   const planner::VoxelClearance field(*run->voxels);
   run->trajectory = planner::generateTrajectory(request, field, scenario.planner.trajectory);
-  run->trajectory_s = since(t0);
+  run->trajectory_s = secondsSince(t0);
 }
 
 control::SetpointTrajectory setpoints(const PlanRun& run, double rate_hz) {
@@ -99,7 +96,7 @@ void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& ma
   run->voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
                                                     scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
                                                     band.lo_m, band.hi_m);
-  run->voxel_map_s = since(t0);
+  run->voxel_map_s = secondsSince(t0);
 }
 
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
@@ -129,7 +126,7 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
   request.homology_class = oracle;
   const auto t0 = std::chrono::steady_clock::now();
   run.plan = solver->solve(request);
-  run.solve_s = since(t0);
+  run.solve_s = secondsSince(t0);
   const auto classes = static_cast<int>(run.plan.topo.classes.size());
   if (oracle >= classes && run.plan.topo.status == planner::PlanStatus::kSolved) {
     throw InputError(oracle_option + " = " + std::to_string(oracle) +

@@ -8,9 +8,8 @@ namespace tgnav::harness::scenes {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Half the camera's horizontal field of view (fovy 60 deg at 4:3 is 75 deg wide) plus a margin.
-constexpr double kHalfFovRad = 42.0 * kPi / 180.0;
+constexpr double kStartViewHalfFovRad = 42.0 * kPi / 180.0;
 constexpr double kStartViewRangeM = 5.0;  // what the VO needs to start: near texture in view
 constexpr double kGoalViewRangeM = 3.0;   // ... and to arrive
 
@@ -141,7 +140,7 @@ Lighting drawLighting(SceneRng& rng) {
 void forceVisibleLevels(Layout& layout) {
   const int steps = 168;  // 0.5 deg
   for (int k = 0; k <= steps; ++k) {
-    const double angle = layout.start.yaw - kHalfFovRad + 2.0 * kHalfFovRad * k / steps;
+    const double angle = layout.start.yaw - kStartViewHalfFovRad + 2.0 * kStartViewHalfFovRad * k / steps;
     upgrade(layout, firstHit(layout, layout.start.x, layout.start.y, angle, kStartViewRangeM));
   }
   for (int k = 0; k < 720; ++k) {

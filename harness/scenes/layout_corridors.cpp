@@ -11,7 +11,7 @@ namespace tgnav::harness::scenes {
 
 namespace {
 
-constexpr int kMaxLayouts = 2000;
+constexpr int kMaxCorridorLayouts = 2000;
 constexpr double kMinSegmentM = 1.2;
 constexpr double kEndOffsetM = 1.1;  // start and goal from the west and east walls
 
@@ -123,7 +123,7 @@ double aisleCentre(const Layout& layout, SceneRng& rng) {
 
 template <typename Draw>
 Layout drawValid(Layout room, SceneRng& rng, Draw draw, const char* what) {
-  for (int attempt = 1; attempt <= kMaxLayouts; ++attempt) {
+  for (int attempt = 1; attempt <= kMaxCorridorLayouts; ++attempt) {
     Layout layout = draw(room, rng);
     layout.start = {round2(layout.xmin + kEndOffsetM), aisleCentre(layout, rng), 0.0};
     layout.goal = {round2(layout.xmax - kEndOffsetM), aisleCentre(layout, rng), 0.0};

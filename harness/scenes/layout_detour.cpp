@@ -28,13 +28,12 @@ namespace tgnav::harness::scenes {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr int kMaxLayouts = 500;
+constexpr int kMaxDetourLayouts = 500;
 constexpr double kBlindRangeM = 10.0;     // the VO's depth range (configs/vo.yaml max_depth_m)
 constexpr double kRouteViewRangeM = 7.0;  // texture the long route keeps in view (as the start)
 constexpr double kEndViewRangeM = 7.0;    // texture at start and goal (the VO's depth range: 10 m)
 // The camera's horizontal half FoV (75 deg wide).
-constexpr double kHalfFovRad = 37.5 * kPi / 180.0;
+constexpr double kViewHalfFovRad = 37.5 * kPi / 180.0;
 constexpr int kRays = 720;     // all round
 constexpr int kViewRays = 41;  // across one view
 constexpr int kYaws = 72;      // the yaws a view is looked for at
@@ -69,7 +68,7 @@ std::vector<int> blocksSeen(const Layout& layout, double x, double y, double ran
 template <typename Visit>
 void forView(const Layout& layout, const Pose2& p, double yaw, double range_m, Visit&& visit) {
   for (int r = 0; r < kViewRays; ++r) {
-    const double angle = yaw + kHalfFovRad * (2.0 * r / (kViewRays - 1) - 1.0);
+    const double angle = yaw + kViewHalfFovRad * (2.0 * r / (kViewRays - 1) - 1.0);
     visit(firstHit(layout, p.x, p.y, angle, range_m));
   }
 }
@@ -217,7 +216,7 @@ Layout detourLayout(std::uint64_t seed) {
   drawRoomBounds(layout, rng, 13.0, 17.0, 9.0, 12.0);
   const double w = layout.xmax - layout.xmin;
   layout.light = drawLighting(rng);
-  for (layout.attempts = 1; layout.attempts <= kMaxLayouts; ++layout.attempts) {
+  for (layout.attempts = 1; layout.attempts <= kMaxDetourLayouts; ++layout.attempts) {
     layout.blocks.clear();
     layout.obstacles.clear();
     addOuterWalls(layout, rng);

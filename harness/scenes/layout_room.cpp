@@ -10,7 +10,7 @@ namespace tgnav::harness::scenes {
 namespace {
 
 constexpr int kPlacementTries = 40;
-constexpr int kMaxLayouts = 2000;
+constexpr int kMaxRoomLayouts = 2000;
 constexpr double kObstacleToEndsM = 1.3;  // an obstacle's distance to start and goal
 
 double drawHeight(SceneRng& rng) { return rng.chance(0.5) ? kRoomHeightM : rng.uniform(1.8, 2.6); }
@@ -106,7 +106,7 @@ Layout roomLayout(std::uint64_t seed) {
   layout.light = drawLighting(rng);
   addOuterWalls(layout, rng);
   const std::size_t walls = layout.blocks.size();
-  for (layout.attempts = 1; layout.attempts <= kMaxLayouts; ++layout.attempts) {
+  for (layout.attempts = 1; layout.attempts <= kMaxRoomLayouts; ++layout.attempts) {
     layout.blocks.resize(walls);
     layout.obstacles.clear();
     const int n = rng.uniformInt(1, 6);

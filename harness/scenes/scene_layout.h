@@ -17,6 +17,8 @@ enum class TextureLevel { kRich, kMedium, kFaint, kPlain };
 const char* toString(SceneKind kind);
 const char* toString(TextureLevel level);
 
+constexpr double kPi = 3.14159265358979323846;
+
 // What a generated scene guarantees (checked by validateLayout).
 constexpr double kFlightHeightM = 1.0;
 constexpr double kRoomHeightM = 3.0;

@@ -10,7 +10,6 @@ namespace tgnav::harness::scenes {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kShift = 4;  // sub-pixel bits of the polygon vertices
 
 // What a level draws: three scales of shapes (count per square metre, size range in metres),
