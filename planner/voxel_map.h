@@ -67,6 +67,9 @@ class VoxelMap {
                                 const std::function<bool(const LandmarkVoxel&)>& keep = {}) const;
   // True if the first occupied voxel from p towards voxel `index` is that voxel.
   bool lineOfSight(const Eigen::Vector3d& p_W, int index) const;
+  // The same by walking every voxel from p (lineOfSight first looks at the voxel the segment
+  // enters the target from, which answers most blocked rays at once): the reference for tests.
+  bool lineOfSightWalked(const Eigen::Vector3d& p_W, int index) const;
 
   // Distance from p to the nearest obstacle voxel's cube (0 inside one, outside the box or the
   // clearance band).

@@ -6,9 +6,14 @@
 
 #include <cmath>
 #include <fstream>
+#include <iostream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "planner/voxel_map.h"
+#include "tests/planner/synthetic_world.h"
 
 namespace tgnav::planner {
 namespace {
@@ -139,6 +144,53 @@ TEST_F(FeatureMapTest, OpportunitiesRoundTripAndOldMapsLoadWithout) {
   EXPECT_DOUBLE_EQ(legacy.landmarks()[0].detectability(), 1.0);
   EXPECT_EQ(legacy.landmarks()[0].p_W, back.landmarks()[0].p_W);
   EXPECT_EQ(legacy.landmarks()[0].ref_kf_p_W, back.landmarks()[0].ref_kf_p_W);
+}
+
+// VoxelMap::lineOfSight answers most blocked rays from the voxel the segment enters the target
+// from; it must give the walk's answer for every ray: random solids and viewpoints, and
+// viewpoints on the voxel lattice's planes, edges and centres, whose rays tie between axes.
+TEST(VoxelMapLineOfSight, AgreesWithTheWalkEverywhere) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int rays = 0;
+  int seen = 0;
+  int lattice = 0;
+  for (int world = 0; world < 6; ++world) {
+    testing::SyntheticWorld w;
+    w.max_W = {6.0, 5.0, 2.0};
+    for (int b = 0; b < 8; ++b) {
+      const Eigen::Vector3d lo(0.1 * std::floor(55 * u(rng)), 0.1 * std::floor(45 * u(rng)), 0.0);
+      const Eigen::Vector3d size(0.1 + 0.1 * std::floor(12 * u(rng)), 0.1 + 0.1 * std::floor(12 * u(rng)),
+                                 world % 2 ? 2.0 : 0.1 * (1 + std::floor(19 * u(rng))));
+      const Eigen::AlignedBox3d box(lo, (lo + size).cwiseMin(w.max_W));
+      w.solids.push_back(box);
+      for (const Eigen::Vector3d& n :
+           {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0)}) {
+        w.texture(box, n, 0.25);
+      }
+    }
+    const FeatureMap map = w.build();
+    const VoxelMap voxels(map, w.min_W, w.max_W);
+    ASSERT_GT(voxels.landmarkVoxels().size(), 50u);
+    for (int v = 0; v < 60; ++v) {
+      Eigen::Vector3d p(6.0 * u(rng), 5.0 * u(rng), 2.0 * u(rng));
+      if (v % 3 == 1) p = (p / 0.1).array().round() * 0.1;           // lattice corners
+      if (v % 3 == 2) p = ((p / 0.1).array().floor() + 0.5) * 0.1;   // voxel centres
+      if (v % 6 == 1) p.z() = 0.05 + 0.1 * std::floor(p.z() / 0.1);  // and a mix of the two
+      lattice += v % 3 != 0;
+      for (const LandmarkVoxel& lv : voxels.landmarkVoxels()) {
+        const bool walked = voxels.lineOfSightWalked(p, lv.index);
+        ASSERT_EQ(voxels.lineOfSight(p, lv.index), walked)
+            << "world " << world << " p " << p.transpose() << " voxel " << lv.centre_W.transpose();
+        ++rays;
+        seen += walked;
+      }
+    }
+  }
+  EXPECT_GT(seen, rays / 20);  // both answers are common
+  EXPECT_LT(seen, rays - rays / 20);
+  std::cout << "[ figure   ] " << rays << " rays (" << lattice << " of 360 viewpoints on the lattice), " << seen
+            << " see their voxel\n";
 }
 
 TEST(Detectability, ObservationsOutOfOpportunitiesAtMostOne) {
