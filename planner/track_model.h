@@ -42,6 +42,18 @@ struct TrackModel {
   std::vector<Term> terms;
   double intercept = 0.0;
   std::string source;  // the file it came from (reports, errors)
+  // The view settings its features were computed with (the file's "view_settings"): a planner
+  // that counts landmarks otherwise (another range or field of view) would feed it other
+  // numbers. Empty for a file that does not record them.
+  struct ViewSettings {
+    double hfov_rad = 0.0;
+    double vfov_rad = 0.0;
+    double min_range_m = 0.0;
+    double max_range_m = 0.0;
+    double max_incidence_rad = 0.0;
+  };
+  bool has_view_settings = false;
+  ViewSettings view_settings;
 
   // The probability that the VO tracks a frame whose view has `support`.
   double probability(const ViewSupport& support) const;

@@ -21,6 +21,9 @@ PnP inliers (the trial's config.yaml vo.min_inliers).
       diagram (DIR/reliability.png, DIR/reliability.csv), and, for the oracle trials
       (planner.oracle_class set), "class flyable" as predicted (every frame of the flown class at
       or above --threshold) against what the VO did (tracked to the goal). Writes DIR/evaluation.json.
+Both take --views NAME: the features from the file NAME of each trial folder, written by
+`tgnav views --trial FOLDER --out FOLDER/NAME [--set ...]` (the same columns computed again at the
+true camera poses with other planner settings), instead of vo.csv's.
 Exit status 2 with one line naming the file on bad input.
 """
 import argparse
@@ -80,14 +83,77 @@ def read_gt_yaw(path):
     return data[:, 0], np.unwrap(np.arctan2(fy, fx))
 
 
-def read_trial(folder, min_z):
-    """Per-frame features, labels and motion of one trial folder, or None without a vo.csv."""
+def read_views(folder, views, vo_header, vo_rows):
+    """vo.csv's rows with their predicted_* columns taken from FOLDER/VIEWS (a `tgnav views` CSV)."""
+    path = os.path.join(folder, views)
+    if not os.path.isfile(path):
+        raise InputError(f"{path}: not found (--views: make it with tgnav views --trial {folder} --out {path})")
+    with open(path) as f:
+        first = f.readline()
+        settings = parse_view_settings(path, first)
+        header = f.readline().strip().split(",")
+        rows = [line.rstrip("\n").split(",") for line in f if line.strip()]
+    if "t" not in header or len(rows) != len(vo_rows):
+        raise InputError(f"{path}: {len(rows)} rows against vo.csv's {len(vo_rows)} (not this trial's views)")
+    t_vo, t_views = vo_header.index("t"), header.index("t")
+    out = []
+    for n, (a, b) in enumerate(zip(vo_rows, rows)):
+        if len(b) != len(header) or abs(float(a[t_vo]) - float(b[t_views])) > 1e-4:
+            raise InputError(f"{path}: line {n + 2} is not vo.csv's frame at t = {a[t_vo]}")
+        row = list(a)
+        for i, name in enumerate(header):
+            if name.startswith("predicted_") and name in vo_header:
+                row[vo_header.index(name)] = b[i]
+        out.append(row)
+    return out, settings
+
+
+VIEW_SETTINGS = ["hfov_rad", "vfov_rad", "min_range_m", "max_range_m", "max_incidence_rad"]
+
+
+def parse_view_settings(path, line):
+    """The '# view_settings: k=v ...' line `tgnav views` writes first, as a dict."""
+    prefix = "# view_settings:"
+    if not line.startswith(prefix):
+        raise InputError(f"{path}: the first line is not '{prefix} ...' (not written by tgnav views)")
+    try:
+        settings = {k: float(v) for k, v in (item.split("=") for item in line[len(prefix):].split())}
+    except ValueError:
+        raise InputError(f"{path}: the first line '{line.strip()}' does not parse")
+    missing = [k for k in VIEW_SETTINGS if k not in settings]
+    if missing:
+        raise InputError(f"{path}: the first line has no {missing[0]}")
+    return {k: settings[k] for k in VIEW_SETTINGS}
+
+
+def config_view_settings(config, folder):
+    """The view settings a trial's vo.csv features were computed with (its config.yaml)."""
+    vis = (config.get("planner") or {}).get("visibility") or {}
+    info = (config.get("planner") or {}).get("information") or {}
+    values = {k: vis.get(k) for k in VIEW_SETTINGS[:4]}
+    values["max_incidence_rad"] = info.get("max_incidence_rad")
+    missing = [k for k, v in values.items() if v is None]
+    if missing:
+        raise InputError(f"{os.path.join(folder, 'config.yaml')}: no planner setting {missing[0]} (the view settings "
+                         "of vo.csv's features)")
+    return {k: float(v) for k, v in values.items()}
+
+
+def read_trial(folder, min_z, views=None):
+    """Per-frame features, labels and motion of one trial folder, or None without a vo.csv. With
+    `views`, the features come from that file of the folder (`tgnav views`) instead of vo.csv."""
     path = os.path.join(folder, "vo.csv")
     if not os.path.isfile(path):
         return None
     with open(path) as f:
         header = f.readline().strip().split(",")
         rows = [line.rstrip("\n").split(",") for line in f if line.strip()]
+    settings = None
+    if views:
+        try:
+            rows, settings = read_views(folder, views, header, rows)
+        except ValueError as e:
+            raise InputError(f"{os.path.join(folder, views)}: a row does not parse ({e})")
     need = ["t", "status", "matches", "inliers", "x_true", "y_true", "z_true"] + [COLUMNS[n] for n in FEATURES]
     missing = [n for n in need if n not in header]
     if missing:
@@ -105,6 +171,8 @@ def read_trial(folder, min_z):
     if len(t) == 0:
         return None
     config = read_config(os.path.join(folder, "config.yaml"))
+    if settings is None:
+        settings = config_view_settings(config, folder)
     min_inliers = float(config_value(config, "vo", "min_inliers", 30))
     x = np.column_stack([np.log1p(raw[n]) if n in LOGGED else raw[n] for n in FEATURES])
     label = np.array([s != "lost" for s in status]) & (inliers >= min_inliers)
@@ -123,12 +191,12 @@ def read_trial(folder, min_z):
         yaw_rate = np.abs(np.interp(t, gt[0], rate))
     oracle = config_value(config, "planner", "oracle_class", -1)
     scene = os.path.basename(folder).split("__")[0]
-    return {"folder": folder, "scene": scene, "x": x[keep], "y": label[keep], "motion": np.column_stack(
+    return {"folder": folder, "scene": scene, "view_settings": settings, "x": x[keep], "y": label[keep], "motion": np.column_stack(
         [speed, yaw_rate])[keep], "oracle": int(oracle) if oracle is not None else -1, "t": t[keep],
         "all_frames": len(t)}
 
 
-def read_sweeps(dirs, min_z):
+def read_sweeps(dirs, min_z, views=None):
     trials = []
     for d in dirs:
         if not os.path.isdir(d):
@@ -137,7 +205,7 @@ def read_sweeps(dirs, min_z):
         if not folders:
             raise InputError(f"{d}: no trials/ folders (a sweep's output folder is expected)")
         for folder in folders:
-            tr = read_trial(folder, min_z)
+            tr = read_trial(folder, min_z, views)
             if tr is not None and len(tr["y"]) > 0:
                 trials.append(tr)
     if not trials:
@@ -200,10 +268,16 @@ def cmd_fit(args):
     unknown = [n for n in names if n not in FEATURES]
     if unknown or not names:
         raise InputError(f"--features: '{unknown[0] if unknown else args.features}' is not one of {', '.join(FEATURES)}")
-    trials = select(read_sweeps(args.sweeps, args.min_z), names)
+    trials = select(read_sweeps(args.sweeps, args.min_z, args.views), names)
     x, y = stack(trials, "x"), stack(trials, "y")
     if y.min() == y.max():
         raise InputError(f"{', '.join(args.sweeps)}: every frame has the same label; nothing to fit")
+    settings = trials[0]["view_settings"]
+    for tr in trials:
+        if tr["view_settings"] != settings:
+            raise InputError(f"{tr['folder']}: view settings {tr['view_settings']} differ from "
+                             f"{trials[0]['folder']}'s {settings}: one model is fitted on features counted one way "
+                             "(--views)")
     mean, scale, weights, intercept = fit_logistic(x, y, args.c)
     train_auc = auc(y, probability(x, mean, scale, weights, intercept))
     loso = leave_one_scene_out(trials, args.c)
@@ -215,10 +289,12 @@ def cmd_fit(args):
         "label": "the VO tracks the frame with at least vo.min_inliers PnP inliers",
         "features": names, "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
         "intercept": intercept,
+        "view_settings": settings,
         "fitted_on": {"sweeps": [os.path.normpath(d) for d in args.sweeps], "scenes": scenes,
                       "trials": len(trials), "frames": int(len(y)), "tracked": int(y.sum()),
+                      "views": args.views or "vo.csv",
                       "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"
-                                 + f" --features {','.join(names)}"},
+                                 + f" --features {','.join(names)}" + (f" --views {args.views}" if args.views else "")},
         "scores": {"train_auc": train_auc, "leave_one_scene_out_auc": loso,
                    "leave_one_scene_out_auc_with_motion": loso_motion},
         "suggested_min_track_probability": threshold,
@@ -294,12 +370,18 @@ def reliability(y, p, bins=10):
 
 def cmd_evaluate(args):
     names, mean, scale, weights, intercept, sha = load_model(args.model)
-    all_trials = read_sweeps(args.sweeps, args.min_z)
+    all_trials = read_sweeps(args.sweeps, args.min_z, args.views)
+    with open(args.model) as f:
+        fitted = json.load(f).get("view_settings")
+    for tr in all_trials if fitted else []:
+        if tr["view_settings"] != {k: float(fitted.get(k, float("nan"))) for k in VIEW_SETTINGS}:
+            raise InputError(f"{tr['folder']}: its features were counted with {tr['view_settings']}, the model "
+                             f"{args.model} with {fitted} (--views: features computed again with the model's settings)")
     trials = select(all_trials, names)
     for tr in trials:
         tr["p"] = probability(tr["x"], mean, scale, weights, intercept)
     y, p = stack(trials, "y"), stack(trials, "p")
-    result = {"model": os.path.normpath(args.model), "model_sha256_16": sha,
+    result = {"model": os.path.normpath(args.model), "model_sha256_16": sha, "views": args.views or "vo.csv",
               "sweeps": [os.path.normpath(d) for d in args.sweeps], "trials": len(trials), "frames": int(len(y)),
               "tracked": int(y.sum()), "roc_auc": auc(y, p), "threshold": args.threshold}
     # one feature alone, for comparison (the gates threshold detections and coverage)
@@ -378,6 +460,9 @@ def main():
     e.add_argument("--out", required=True)
     e.add_argument("--threshold", type=float, default=0.5)
     e.add_argument("--min-z", type=float, default=0.5)
+    for p in (f, e):
+        p.add_argument("--views", help="take the features from this file of each trial folder (a `tgnav views` CSV, "
+                                       "e.g. at another visibility range) instead of vo.csv's predicted_* columns")
     args = ap.parse_args()
     try:
         cmd_fit(args) if args.command == "fit" else cmd_evaluate(args)

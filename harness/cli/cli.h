@@ -22,6 +22,7 @@ void addFlyCommand(CLI::App& app);
 void addMapCommand(CLI::App& app);
 void addPlanCommand(CLI::App& app);
 void addTrialCommand(CLI::App& app);
+void addViewsCommand(CLI::App& app);
 void addVoCommand(CLI::App& app);
 
 }  // namespace tgnav::cli

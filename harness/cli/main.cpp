@@ -24,6 +24,7 @@ int runCommandLine(int argc, char** argv) {
   tgnav::cli::addTrialCommand(app);
   tgnav::cli::addSweepCommand(app);
   tgnav::cli::addReportCommand(app);
+  tgnav::cli::addViewsCommand(app);
   tgnav::cli::addVoCommand(app);
   tgnav::cli::addEvalCommand(app);
   tgnav::cli::addSceneCommand(app);

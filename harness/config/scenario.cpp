@@ -1,9 +1,12 @@
 #include "harness/config/scenario.h"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <tuple>
 
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
@@ -130,6 +133,28 @@ class SectionReader {
   const YamlDoc* overrides_;
 };
 
+// A model fitted on features counted with other view settings than the planner's: InputError
+// naming the setting, both values and the fix.
+void checkViewSettings(const planner::TrackModel& model, const planner::PerceptionPlannerConfig& perception,
+                       const std::string& where) {
+  if (!model.has_view_settings) return;
+  const planner::TrackModel::ViewSettings& fitted = model.view_settings;
+  const std::tuple<const char*, double, double> pairs[] = {
+      {"planner.visibility.hfov_rad", fitted.hfov_rad, perception.visibility.hfov_rad},
+      {"planner.visibility.vfov_rad", fitted.vfov_rad, perception.visibility.vfov_rad},
+      {"planner.visibility.min_range_m", fitted.min_range_m, perception.visibility.min_range_m},
+      {"planner.visibility.max_range_m", fitted.max_range_m, perception.visibility.max_range_m},
+      {"planner.information.max_incidence_rad", fitted.max_incidence_rad, perception.information.max_incidence_rad}};
+  for (const auto& [key, model_value, config_value] : pairs) {
+    if (std::abs(model_value - config_value) <= 1e-9 * std::max(1.0, std::abs(model_value))) continue;
+    std::ostringstream msg;
+    msg << where << ": key 'planner.information.track_model' has value '" << model.source << "': it was fitted with "
+        << key << " = " << model_value << ", this config has " << config_value
+        << " (fit a model for these settings: scripts/fit_track_model.py --views)";
+    throw InputError(msg.str());
+  }
+}
+
 // Reads the learned perception model that planner.information.track_model names (relative to the
 // current directory when --set gives it, else to the scenario file) into the planners' settings,
 // and records its absolute path there (config.yaml); no model when the key is "none".
@@ -148,6 +173,7 @@ void readTrackModel(const YamlDoc& doc, const YamlDoc* overrides, PlannerSetting
     }
     info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
     info.track_model = file.string();
+    checkViewSettings(*info.model, planner->perception, overridden ? "--set" : doc.file().string());
   }
   planner->shareFromPerception();
 }

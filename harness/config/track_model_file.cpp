@@ -92,6 +92,24 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
     model.terms.push_back(term);
   }
   model.intercept = number(file, member(file, doc, "intercept"), "intercept");
+  const auto settings = doc.find("view_settings");
+  if (settings != doc.end()) {
+    if (!settings->is_object()) {
+      fail(file, "key 'view_settings' has value '" + settings->dump().substr(0, 80) + "', expected an object");
+    }
+    planner::TrackModel::ViewSettings& v = model.view_settings;
+    const std::pair<const char*, double*> keys[] = {{"hfov_rad", &v.hfov_rad},
+                                                    {"vfov_rad", &v.vfov_rad},
+                                                    {"min_range_m", &v.min_range_m},
+                                                    {"max_range_m", &v.max_range_m},
+                                                    {"max_incidence_rad", &v.max_incidence_rad}};
+    for (const auto& [key, value] : keys) {
+      const std::string name = std::string("view_settings.") + key;
+      if (!settings->contains(key)) fail(file, "key '" + name + "' is missing");
+      *value = number(file, (*settings)[key], name);
+    }
+    model.has_view_settings = true;
+  }
   return model;
 }
 

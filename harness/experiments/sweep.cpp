@@ -103,13 +103,15 @@ void checkSettingKey(const YamlDoc& doc, const YAML::Node& key_node, const std::
   }
 }
 
-// A value as `--set` takes it; a `vehicle` (a file) made absolute from the sweep file's folder,
-// as the runs' scenarios are, so that it means the same wherever the trials run.
+// A value as `--set` takes it; a file (a `vehicle`, a `planner.information.track_model` other than
+// none) made absolute from the sweep file's folder, as the runs' scenarios are, so that it means
+// the same wherever the trials run.
 std::string settingValue(const YamlDoc& doc, const std::string& key, const YAML::Node& value) {
   std::string text = valueText(value);
-  if (key != "vehicle") return text;
+  const bool file = key == "vehicle" || (key == "planner.information.track_model" && text != "none");
+  if (!file) return text;
   const fs::path p = fs::absolute(doc.file().parent_path() / text).lexically_normal();
-  if (!isRegularFile(p)) doc.fail(value, "vehicle: file " + p.string() + " not found");
+  if (!isRegularFile(p)) doc.fail(value, key + ": file " + p.string() + " not found");
   return p.string();
 }
 

@@ -25,4 +25,16 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   return out;
 }
 
+const char* const kPredictionColumns =
+    "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
+    "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_track_probability";
+
+void writePredictionColumns(std::ostream& out, const FramePrediction& prediction) {
+  const planner::ViewSupport& view = prediction.support;
+  out << prediction.score << ',' << static_cast<int>(view.landmarks) << ',' << view.coverage() << ',' << view.detections
+      << ',' << view.near_detections << ',' << view.meanRangeM() << ',' << view.columnSpan() << ',' << view.rowSpan()
+      << ',';
+  if (prediction.track_probability >= 0.0) out << prediction.track_probability;
+}
+
 }  // namespace tgnav::harness

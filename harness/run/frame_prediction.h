@@ -2,6 +2,7 @@
 // What the planner's perception model predicts for the camera poses a trial really flew, for
 // calibrating the model against the VO (vo.csv's predicted_* columns beside the VO's own counts).
 #include <Eigen/Geometry>
+#include <ostream>
 #include <vector>
 
 #include "planner/perception.h"
@@ -25,5 +26,10 @@ struct FramePrediction {
 FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isometry3d& X_WC,
                              const planner::VisibilityConfig& visibility,
                              const planner::InformationConfig& information);
+
+// vo.csv's columns of a prediction (`tgnav views` writes the same), and one frame's values in
+// them: comma-separated, no leading or trailing comma; the probability is empty without a model.
+extern const char* const kPredictionColumns;
+void writePredictionColumns(std::ostream& out, const FramePrediction& prediction);
 
 }  // namespace tgnav::harness

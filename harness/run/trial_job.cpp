@@ -107,9 +107,7 @@ std::string voCsv(const TrialResult& r) {
   out.precision(6);
   out << std::fixed;
   out << "t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
-         "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
-         "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_track_probability,"
-         "ba_correction_m,ba_correction_rad,ba_outliers,keyframe_rule,reason\n";
+      << kPredictionColumns << ",ba_correction_m,ba_correction_rad,ba_outliers,keyframe_rule,reason\n";
   for (const TrialFrame& f : r.frames) {
     const Eigen::Vector3d p = f.X_WC_true.translation();
     const Eigen::Vector3d e = f.vo.X_WC.translation();
@@ -121,11 +119,8 @@ std::string voCsv(const TrialResult& r) {
     } else {
       out << ",,";
     }
-    const planner::ViewSupport& view = f.predicted.support;
-    out << ',' << f.predicted.score << ',' << static_cast<int>(view.landmarks) << ',' << view.coverage() << ','
-        << view.detections << ',' << view.near_detections << ',' << view.meanRangeM() << ',' << view.columnSpan() << ','
-        << view.rowSpan() << ',';
-    if (f.predicted.track_probability >= 0.0) out << f.predicted.track_probability;
+    out << ',';
+    writePredictionColumns(out, f.predicted);
     out << ',';
     if (std::isfinite(f.vo.ba_correction_m)) {  // keyframes that bundle adjustment refined
       out << f.vo.ba_correction_m << ',' << f.vo.ba_correction_rad << ',' << f.vo.ba_outliers;

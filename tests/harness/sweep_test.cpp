@@ -122,6 +122,28 @@ TEST(Sweep, RrtStarWithoutSamplesTakesTheConfiguredBudget) {
   EXPECT_EQ(s.trials[0].id, "smoke__rrtstar-1000__s03");
 }
 
+TEST(Sweep, TrackModelIsAFileRelativeToTheSweep) {
+  const fs::path dir = test::tempDir();
+  fs::copy_file(test::sourceDir() / "configs/track_model.json", dir / "model.json");
+  const Sweep s = loadSweep(sweepFile(dir,
+                                      "seeds: [1]\nruns:\n  - {scenario: SC/smoke.yaml, planner: proposed, set: "
+                                      "{planner.information.track_model: model.json}}\n  - {scenario: SC/smoke.yaml, "
+                                      "planner: agnostic, set: {planner.information.track_model: none}}\n"));
+  ASSERT_EQ(s.trials.size(), 2u);
+  const std::pair<std::string, std::string> absolute{"planner.information.track_model", (dir / "model.json").string()};
+  const std::vector<std::pair<std::string, std::string>> expected{absolute};
+  EXPECT_EQ(s.trials[0].set, expected);
+  EXPECT_EQ(s.trials[1].set.back(), (std::pair<std::string, std::string>{"planner.information.track_model", "none"}));
+  const std::string msg = test::inputError([&] {
+    loadSweep(sweepFile(dir,
+                        "seeds: [1]\nset: {planner.information.track_model: gone.json}\nruns:\n  - "
+                        "{scenario: SC/smoke.yaml, planner: proposed}\n"));
+  });
+  EXPECT_NE(msg.find("planner.information.track_model: file " + (dir / "gone.json").string() + " not found"),
+            std::string::npos)
+      << msg;
+}
+
 TEST(Sweep, VehicleAxisIsAFileRelativeToTheSweepNamedByItsStem) {
   const fs::path dir = test::tempDir();
   const std::string hex = (test::sourceDir() / "models/vehicles/hexarotor.yaml").string();

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "harness/base/errors.h"
@@ -61,6 +62,10 @@ TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
       {with("[2.0, -1.0]", "[2.0, \"x\"]"), "key 'weights[1]' has value '\"x\"', expected a number"},
       {with("\"intercept\": 0.25", "\"intercept\": 1e999"), "not JSON"},
       {with("\"intercept\": 0.25,", ""), "key 'intercept' is missing"},
+      {with("\"intercept\": 0.25,", "\"intercept\": 0.25, \"view_settings\": 10,"),
+       "key 'view_settings' has value '10', expected an object"},
+      {with("\"intercept\": 0.25,", "\"intercept\": 0.25, \"view_settings\": {\"hfov_rad\": 1},"),
+       "key 'view_settings.vfov_rad' is missing"},
   };
   for (const auto& [text, expected] : cases) {
     const auto file = test::writeFile(dir / "bad.json", text);
@@ -104,6 +109,43 @@ TEST_F(TrackModelScenario, AMissingModelIsNamedWithItsKey) {
   const YamlDoc p = YamlDoc::fromOverrides({"planner.information.min_track_probability=1"});
   EXPECT_EQ(inputError([&] { loadScenario(scenario(""), &p); }),
             "--set planner.information.min_track_probability=1: min_track_probability = 1: must be in (0, 1)");
+}
+
+// A model records the view settings its features were counted with; a scenario that plans with
+// others is refused, naming the setting and both values.
+TEST_F(TrackModelScenario, AModelFittedForOtherViewSettingsIsRefused) {
+  const planner::PerceptionPlannerConfig defaults;
+  const auto model = [&](double max_range_m) {
+    std::ostringstream text;
+    text.precision(17);
+    text << R"({"format": "tgnav-track-model", "version": 1, "kind": "logistic", "features": ["coverage"],
+      "mean": [0.2], "scale": [0.1], "weights": [1.0], "intercept": 0.0, "view_settings": {"hfov_rad": )"
+         << defaults.visibility.hfov_rad << ", \"vfov_rad\": " << defaults.visibility.vfov_rad
+         << ", \"min_range_m\": " << defaults.visibility.min_range_m << ", \"max_range_m\": " << max_range_m
+         << ", \"max_incidence_rad\": " << defaults.information.max_incidence_rad << "}}";
+    return text.str();
+  };
+  test::writeFile(dir_ / "same.json", model(defaults.visibility.max_range_m));
+  const Scenario s = loadScenario(scenario("planner: {information: {track_model: same.json}}\n"));
+  ASSERT_NE(s.planner.perception.information.model, nullptr);
+  EXPECT_TRUE(s.planner.perception.information.model->has_view_settings);
+  EXPECT_EQ(s.planner.perception.information.model->view_settings.max_range_m, defaults.visibility.max_range_m);
+
+  test::writeFile(dir_ / "far.json", model(defaults.visibility.max_range_m + 4.0));
+  const auto file = scenario("planner: {information: {track_model: far.json}}\n");
+  const std::string msg = inputError([&] { loadScenario(file); });
+  EXPECT_EQ(msg.rfind(file.string() + ": key 'planner.information.track_model' has value '" +
+                          (dir_ / "far.json").string() + "': it was fitted with planner.visibility.max_range_m = ",
+                      0),
+            0u)
+      << msg;
+  EXPECT_NE(msg.find("this config has " + std::to_string(static_cast<int>(defaults.visibility.max_range_m))),
+            std::string::npos)
+      << msg;
+  // The same planner settings as the model's: accepted.
+  const YamlDoc far = YamlDoc::fromOverrides(
+      {"planner.visibility.max_range_m=" + std::to_string(defaults.visibility.max_range_m + 4.0)});
+  EXPECT_NE(loadScenario(file, &far).planner.perception.information.model, nullptr);
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // the VO, and the contract on bad input and interruption.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
@@ -389,6 +390,94 @@ TEST(SmokeTrialCli, PlanTakesSetOverrides) {
   EXPECT_EQ(lines(run.output), 1) << run.output;
   EXPECT_NE(run.output.find("no_such_key"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "q"));
+}
+
+// `tgnav views` computes a flown trial's view features again at its true camera poses: with the
+// trial's own settings they are vo.csv's, to the byte; a longer visibility range counts more;
+// bad input is one line, exit 2, nothing written.
+TEST(SmokeTrialCli, ViewsRecomputeTheFlownFeatures) {
+  const auto dir = tempDir();
+  const auto trial = dir / "trial";
+  ASSERT_EQ(shell(trialCommand("--planner proposed --seed 2" + kSmall + " --out " + trial.string())).rc, 0);
+  const std::string views =
+      std::string(TGNAV_BIN) + " views --map-cache " + TGNAV_TEST_CACHE + " --trial " + trial.string() + " ";
+  CmdResult run = shell(views + "--out " + (dir / "same.csv").string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  run = shell(views + "--set planner.visibility.max_range_m=2 --out " + (dir / "near.csv").string());
+  ASSERT_EQ(run.rc, 0) << run.output;
+
+  // Column by name: every row of vo.csv.
+  const auto table = [](const std::string& text) {
+    std::vector<std::vector<std::string>> rows;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("# ", 0) == 0) continue;  // `tgnav views`' settings line
+      std::vector<std::string> cells;
+      std::istringstream r(line);
+      for (std::string c; std::getline(r, c, ',');) cells.push_back(c);
+      if (!line.empty() && line.back() == ',') cells.emplace_back();
+      rows.push_back(cells);
+    }
+    return rows;
+  };
+  const auto vo = table(readText(trial / "vo.csv"));
+  const auto same = table(readText(dir / "same.csv"));
+  const auto near = table(readText(dir / "near.csv"));
+  EXPECT_EQ(readText(dir / "near.csv").rfind("# view_settings: hfov_rad=", 0), 0u);
+  EXPECT_NE(readText(dir / "near.csv").find(" max_range_m=2 "), std::string::npos);
+  ASSERT_EQ(same.size(), vo.size());
+  ASSERT_EQ(near.size(), vo.size());
+  ASSERT_GT(vo.size(), 100u);
+  const auto column = [](const std::vector<std::string>& header, const std::string& name) {
+    const auto it = std::find(header.begin(), header.end(), name);
+    EXPECT_NE(it, header.end()) << name;
+    return static_cast<std::size_t>(it - header.begin());
+  };
+  double detections = 0.0;
+  double near_detections = 0.0;
+  for (const std::string& name : same[0]) {
+    const std::size_t a = column(vo[0], name);
+    const std::size_t b = column(same[0], name);
+    for (std::size_t i = 1; i < vo.size(); ++i) EXPECT_EQ(vo[i][a], same[i][b]) << name << ", row " << i;
+  }
+  const std::size_t d = column(same[0], "predicted_detections");
+  for (std::size_t i = 1; i < vo.size(); ++i) {
+    detections += std::stod(same[i][d]);
+    near_detections += std::stod(near[i][d]);
+    EXPECT_LE(std::stod(near[i][d]), std::stod(same[i][d]) + 1e-6) << "row " << i;
+  }
+  std::cout << "[ figure   ] views: mean predicted detections " << detections / (vo.size() - 1) << " as flown (6 m), "
+            << near_detections / (vo.size() - 1) << " within 2 m\n";
+  EXPECT_LT(near_detections, 0.9 * detections);
+
+  // Bad input.
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--set planner.visibility.max_range_m=-1", "max_range_m"},
+      {"--set planner.no_such_key=1", "no_such_key"},
+      {"--out " + (dir / "same.csv").string(), "exists"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const std::string out = args.rfind("--out", 0) == 0 ? "" : " --out " + (dir / "bad.csv").string();
+    run = shell(views + args + out);
+    EXPECT_EQ(run.rc, 2) << args << "\n" << run.output;
+    EXPECT_EQ(lines(run.output), 1) << run.output;
+    EXPECT_NE(run.output.find(expected), std::string::npos) << run.output;
+  }
+  run = shell(std::string(TGNAV_BIN) + " views --trial " + dir.string() + " --out " + (dir / "bad.csv").string());
+  EXPECT_EQ(run.rc, 2) << run.output;
+  EXPECT_NE(run.output.find("no config.yaml"), std::string::npos) << run.output;
+  // A ground truth that ends before the frames: the file and the frame are named.
+  const auto cut = dir / "cut";
+  std::filesystem::copy(trial, cut);
+  const std::string gt = readText(trial / "gt.tum");
+  std::ofstream(cut / "gt.tum") << gt.substr(0, gt.size() / 2).substr(0, gt.substr(0, gt.size() / 2).rfind('\n') + 1);
+  run = shell(std::string(TGNAV_BIN) + " views --map-cache " + TGNAV_TEST_CACHE + " --trial " + cut.string() +
+              " --out " + (dir / "bad.csv").string());
+  EXPECT_EQ(run.rc, 2) << run.output;
+  EXPECT_EQ(lines(run.output), 1) << run.output;
+  EXPECT_NE(run.output.find("gt.tum: no pose at t = "), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.csv"));
 }
 
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
