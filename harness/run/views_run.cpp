@@ -65,8 +65,7 @@ std::vector<VoRow> readVoCsv(const fs::path& file) {
     };
     rows.push_back({number(t_col, "t"), number(d_col, "predicted_detections")});
   }
-  if (rows.empty()) throw InputError(file.string() + ": no frames");
-  return rows;
+  return rows;  // none: a trial that never flew (no plan), whose views are a header alone
 }
 
 std::vector<vo::StampedPose> readGroundTruth(const fs::path& file) {
@@ -112,7 +111,8 @@ ViewsResult runViews(const ViewsJob& job) {
   const YamlDoc overrides = YamlDoc::fromOverrides(job.set);
   const Scenario scenario = loadScenario(config, &overrides);
   const std::vector<VoRow> rows = readVoCsv(job.trial / "vo.csv");
-  const std::vector<vo::StampedPose> gt = readGroundTruth(job.trial / "gt.tum");
+  const std::vector<vo::StampedPose> gt =
+      rows.empty() ? std::vector<vo::StampedPose>{} : readGroundTruth(job.trial / "gt.tum");
   std::vector<const vo::StampedPose*> poses;
   poses.reserve(rows.size());
   for (const VoRow& row : rows) {
@@ -154,8 +154,8 @@ ViewsResult runViews(const ViewsJob& job) {
   }
   writeFileAtomic(job.out, out.str());
   result.frames = static_cast<int>(rows.size());
-  result.mean_detections /= result.frames;
-  result.mean_detections_vo /= result.frames;
+  result.mean_detections /= std::max(1, result.frames);
+  result.mean_detections_vo /= std::max(1, result.frames);
   char line[512];
   std::snprintf(line, sizeof line,
                 "tgnav views: %d frames of %s at their true camera poses: mean predicted detections %.1f (as flown "

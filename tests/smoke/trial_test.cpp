@@ -478,6 +478,17 @@ TEST(SmokeTrialCli, ViewsRecomputeTheFlownFeatures) {
   EXPECT_EQ(lines(run.output), 1) << run.output;
   EXPECT_NE(run.output.find("gt.tum: no pose at t = "), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(dir / "bad.csv"));
+  // A trial that never flew (no plan: vo.csv is a header alone) has views of no frames.
+  const auto unflown = dir / "unflown";
+  std::filesystem::copy(trial, unflown);
+  const std::string vo_text = readText(trial / "vo.csv");
+  std::ofstream(unflown / "vo.csv", std::ios::trunc) << vo_text.substr(0, vo_text.find('\n') + 1);
+  std::ofstream(unflown / "gt.tum", std::ios::trunc) << "# timestamp tx ty tz qx qy qz qw\n";
+  run = shell(std::string(TGNAV_BIN) + " views --map-cache " + TGNAV_TEST_CACHE + " --trial " + unflown.string() +
+              " --out " + (dir / "none.csv").string());
+  EXPECT_EQ(run.rc, 0) << run.output;
+  EXPECT_NE(run.output.find(": 0 frames of "), std::string::npos) << run.output;
+  EXPECT_EQ(table(readText(dir / "none.csv")).size(), 1u);  // the header
 }
 
 TEST(SmokeTrialCli, InterruptLeavesPartialResultsMarkedIncomplete) {
