@@ -39,7 +39,23 @@ def write_trial(folder, rng, oracle=-1, detections_scale=1.0):
     with open(os.path.join(folder, "vo.csv"), "w") as f:
         f.write(HEADER + "\n" + "\n".join(rows) + "\n")
     with open(os.path.join(folder, "config.yaml"), "w") as f:
-        f.write(f"vo:\n  min_inliers: 30\nplanner:\n  oracle_class: {oracle}\n")
+        f.write(f"vo:\n  min_inliers: 30\nplanner:\n  oracle_class: {oracle}\n  visibility:\n    hfov_rad: 1.3125\n"
+                "    vfov_rad: 1.0472\n    min_range_m: 0.3\n    max_range_m: 6\n  information:\n"
+                "    max_incidence_rad: 1.5707963267948966\n")
+
+
+def write_views(folder, max_range_m, rows=None):
+    """What `tgnav views` writes for the trial in `folder`: its settings line, then its vo.csv's
+    predicted_* columns (here: the same values, counted at another range)."""
+    with open(os.path.join(folder, "vo.csv")) as f:
+        header = f.readline().strip().split(",")
+        lines = [line.rstrip("\n").split(",") for line in f if line.strip()]
+    cols = ["t"] + [c for c in header if c.startswith("predicted_")]
+    idx = [header.index(c) for c in cols]
+    body = [",".join(row[i] for i in idx) for row in lines][:rows]
+    with open(os.path.join(folder, "views.csv"), "w") as f:
+        f.write(f"# view_settings: hfov_rad=1.3125 vfov_rad=1.0472 min_range_m=0.3 max_range_m={max_range_m} "
+                "max_incidence_rad=1.5707963267948966\n" + ",".join(cols) + "\n" + "\n".join(body) + "\n")
 
 
 def make_sweep(root, scenes, seed):
@@ -132,6 +148,46 @@ class FitTrackModel(unittest.TestCase):
         r = run("evaluate", calib, "--model", bad_model, "--out", os.path.join(self.dir, "e"))
         self.assertEqual(r.returncode, 2)
         self.assertIn(bad_model, r.stderr)
+
+    def test_views_replace_the_features_and_their_settings_are_kept(self):
+        calib = os.path.join(self.dir, "calib")
+        held = os.path.join(self.dir, "held")
+        make_sweep(calib, ["a-1", "b-1"], 1)
+        make_sweep(held, ["c-1"], 2)
+        for root in (calib, held):
+            for t in os.listdir(os.path.join(root, "trials")):
+                write_views(os.path.join(root, "trials", t), 10)
+        six, ten = os.path.join(self.dir, "six.json"), os.path.join(self.dir, "ten.json")
+        self.assertEqual(run("fit", calib, "--out", six).returncode, 0)
+        r = run("fit", calib, "--out", ten, "--views", "views.csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(read_json(six)["view_settings"]["max_range_m"], 6.0)  # from config.yaml
+        self.assertEqual(read_json(ten)["view_settings"]["max_range_m"], 10.0)  # from views.csv
+        self.assertEqual(read_json(ten)["fitted_on"]["views"], "views.csv")
+        self.assertEqual(read_json(ten)["weights"], read_json(six)["weights"])  # the same numbers here
+        r = run("evaluate", held, "--model", ten, "--views", "views.csv", "--out", os.path.join(self.dir, "e10"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        # a model evaluated on features counted otherwise: refused, naming both
+        r = run("evaluate", held, "--model", six, "--views", "views.csv", "--out", os.path.join(self.dir, "e6"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("its features were counted with", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        # views of another trial (too few rows), and a missing views file
+        trial = os.path.join(held, "trials", "c-1__proposed__s01")
+        write_views(trial, 10, rows=50)
+        r = run("evaluate", held, "--model", ten, "--views", "views.csv", "--out", os.path.join(self.dir, "e"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(trial, "views.csv") + ": 50 rows against vo.csv's 200", r.stderr)
+        os.remove(os.path.join(trial, "views.csv"))
+        r = run("evaluate", held, "--model", ten, "--views", "views.csv", "--out", os.path.join(self.dir, "e"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn(os.path.join(trial, "views.csv") + ": not found", r.stderr)
+        # views whose settings differ between trials: one model is fitted on one kind
+        write_views(os.path.join(calib, "trials", "a-1__proposed__s01"), 8)
+        r = run("fit", calib, "--out", os.path.join(self.dir, "mixed.json"), "--views", "views.csv")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("differ from", r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.dir, "mixed.json")))
 
 
 if __name__ == "__main__":
