@@ -102,8 +102,9 @@ const vo::StampedPose* poseAt(const std::vector<vo::StampedPose>& gt, double t_s
 
 ViewsResult runViews(const ViewsJob& job) {
   const fs::path config = job.trial / "config.yaml";
-  if (!isRegularFile(config))
+  if (!isRegularFile(config)) {
     throw InputError("--trial: " + job.trial.string() + " holds no config.yaml (not a trial)");
+  }
   if (job.out.empty()) throw InputError("--out: required");
   if (!job.force && fs::exists(job.out)) {
     throw InputError("--out: " + job.out.string() + " exists; use --force to replace it");
