@@ -61,6 +61,15 @@ int ImageCells::operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_
   return row * kImageCols + col;
 }
 
+bool ImageCells::inner(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const {
+  const Eigen::Vector3d d = l_W - p_W;
+  const double forward = cos_yaw_ * d.x() + sin_yaw_ * d.y();
+  if (forward <= 0.0) return false;
+  const double left = -sin_yaw_ * d.x() + cos_yaw_ * d.y();
+  const double limit = (1.0 - kImageBorderShare) * forward;
+  return std::abs(left) <= limit * tan_half_hfov_ && std::abs(d.z()) <= limit * tan_half_vfov_;
+}
+
 int imageCell(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
               const VisibilityConfig& visibility) {
   return ImageCells(yaw_rad, visibility)(p_W, l_W);
@@ -195,7 +204,7 @@ Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::
   for (const WeightedPoint& pt : points) {
     if (in_view(p_W, pt.p_W) && withinIncidence(p_W, pt, config)) {
       addCentredInformation(p_W, pt.p_W, pt.weight, config.bearing_noise_rad, &info);
-      view.add(pt, (pt.p_W - p_W).norm(), cell(p_W, pt.p_W));
+      view.add(pt, (pt.p_W - p_W).norm(), cell(p_W, pt.p_W), cell.inner(p_W, pt.p_W));
     }
   }
   if (support != nullptr) *support = view;

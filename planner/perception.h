@@ -57,8 +57,18 @@ struct InformationConfig {
   double min_track_probability = 0.5;
   std::shared_ptr<const TrackModel> model;  // read from track_model; not a key
 
-  // True when a pose's score needs the image cells its landmarks fall in (the coverage gate or a model).
-  bool usesImageCells() const { return min_image_coverage > 0.0 || model != nullptr; }
+  // True when a pose's score needs the image cells its landmarks fall in: the coverage gate, or
+  // a model with a term on coverage, column span or row span (with a model the gates are not used).
+  bool usesImageCells() const {
+    if (model == nullptr) return min_image_coverage > 0.0;
+    return model->uses(TrackFeature::kCoverage) || model->uses(TrackFeature::kColumnSpan) ||
+           model->uses(TrackFeature::kRowSpan);
+  }
+  // True when a pose's score needs ViewSupport::inner_detections (a model that reads them).
+  bool usesInnerDetections() const {
+    return model != nullptr &&
+           (model->uses(TrackFeature::kLogInnerDetections) || model->uses(TrackFeature::kLogInnerNearDetections));
+  }
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -94,24 +104,38 @@ constexpr int kImageRows = 6;
 // The range within which a landmark's detections also count as near ones (ViewSupport).
 constexpr double kNearRangeM = 3.0;
 
+// The image's inner part (ViewSupport::inner_detections): points whose projection lies at least
+// this share of the half-width (half-height) inside the image's edge. The VO's ORB detector finds
+// no corner within edge_threshold_px x scale_factor^level of the border of each pyramid level
+// (19 px at level 0, 68 px at level 7 at the defaults; about 35 px averaged over the levels by
+// the share of features each keeps), so a landmark in that band is seldom detected whatever the
+// survey measured of it elsewhere: 0.1 is 32 px of 640 and 24 px of 480.
+constexpr double kImageBorderShare = 0.1;
+
 // What backs a pose's information: the landmarks that count and the image cells they fall in.
 struct ViewSupport {
-  double landmarks = 0.0;         // their summed weight
-  double detections = 0.0;        // their summed detections
-  double near_detections = 0.0;   // the detections of those within kNearRangeM of the camera
-  double range_detections = 0.0;  // sum of detections x range, m
-  std::uint64_t cells = 0;        // bit row * kImageCols + col: a landmark falls in that cell
-  void count(const WeightedPoint& point, double range_m) {
+  double landmarks = 0.0;              // their summed weight
+  double detections = 0.0;             // their summed detections
+  double near_detections = 0.0;        // the detections of those within kNearRangeM of the camera
+  double inner_detections = 0.0;       // the detections of those in the image's inner part (kImageBorderShare)
+  double inner_near_detections = 0.0;  // the detections of those both inner and near
+  double range_detections = 0.0;       // sum of detections x range, m
+  std::uint64_t cells = 0;             // bit row * kImageCols + col: a landmark falls in that cell
+  // `inner`: the point projects into the image's inner part (ImageCells::inner); callers whose
+  // model does not use inner_detections may pass false.
+  void count(const WeightedPoint& point, double range_m, bool inner) {
     landmarks += point.weight;
     detections += point.detections;
     range_detections += point.detections * range_m;
     if (range_m < kNearRangeM) near_detections += point.detections;
+    if (inner) inner_detections += point.detections;
+    if (inner && range_m < kNearRangeM) inner_near_detections += point.detections;
   }
   void cover(int cell) {
     if (cell >= 0) cells |= std::uint64_t{1} << cell;
   }
-  void add(const WeightedPoint& point, double range_m, int cell) {
-    count(point, range_m);
+  void add(const WeightedPoint& point, double range_m, int cell, bool inner) {
+    count(point, range_m, inner);
     cover(cell);
   }
   double coverage() const;    // share of the kImageCols x kImageRows cells marked
@@ -130,6 +154,9 @@ class ImageCells {
  public:
   ImageCells(double yaw_rad, const VisibilityConfig& visibility);
   int operator()(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const;
+  // True when l_W projects into the image's inner part: in front of the camera and at least
+  // kImageBorderShare of the half-width and half-height inside the edges.
+  bool inner(const Eigen::Vector3d& p_W, const Eigen::Vector3d& l_W) const;
 
  private:
   double cos_yaw_;

@@ -28,38 +28,59 @@ void perpendicularBasis(const Eigen::Vector3d& tangent, Eigen::Vector3d* e1, Eig
   *e1 = up.cross(t).normalized();  // horizontal, to the left of the path
   *e2 = t.cross(*e1);              // "up" within the plane
 }
-// Which first-node yaws (yaw_of[k]; yaw_of[0] is the vehicle's own) the turn on the spot at
-// `start` may reach: every lattice yaw it sweeps after the vehicle's own, the shorter way round
-// (both ways for a half turn, which could go either way), scores at least `floor`. Not turning
-// is always allowed: the VO starts from the vehicle's own view whatever the model says of it.
-std::vector<bool> startTurnAllowed(const Eigen::Vector3d& start, const std::vector<double>& yaw_of,
-                                   const VoxelMap& voxels, const VisibilityConfig& visibility,
-                                   const InformationConfig& information, double floor) {
+
+// The turn on the spot at `start` from the vehicle's own yaw (yaw_of[0]) to each first-node yaw
+// yaw_of[k], the shorter way round (both ways for a half turn, which could go either way).
+struct StartTurn {
+  // Which yaws it may reach: every lattice yaw it sweeps after the vehicle's own scores at least
+  // the floor. Not turning is always allowed: the VO starts from the vehicle's own view whatever
+  // the model says of it.
+  std::vector<bool> ok;
+  std::vector<double> failure;  // the summed -ln p of the views it sweeps (with a model; else 0)
+};
+
+StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>& yaw_of, const VoxelMap& voxels,
+                         const VisibilityConfig& visibility, const InformationConfig& information, double floor) {
   const int yaws = static_cast<int>(yaw_of.size());
   const std::vector<WeightedPoint> points = aggregateSlots(voxels, voxels.visibleSlots(start, visibility));
   std::vector<double> view(yaw_of.size());
+  std::vector<double> miss(yaw_of.size(), 0.0);
   for (int k = 0; k < yaws; ++k) {
-    view[static_cast<std::size_t>(k)] =
-        poseScore(start, yaw_of[static_cast<std::size_t>(k)], points, visibility, information);
+    const auto ku = static_cast<std::size_t>(k);
+    ViewSupport support;
+    const Matrix6d info = poseInformation(start, yaw_of[ku], points, visibility, information, &support);
+    view[ku] = scoreInformation(info, support, information);
+    if (information.model) miss[ku] = failureCost(information.model->probability(support));
   }
   const double kNoView = std::numeric_limits<double>::infinity();
-  std::vector<bool> ok(yaw_of.size(), false);
-  ok[0] = true;
+  StartTurn turn{std::vector<bool>(yaw_of.size(), false), std::vector<double>(yaw_of.size(), 0.0)};
+  turn.ok[0] = true;
   double left = kNoView;
+  double left_miss = 0.0;
   for (int k = 1; 2 * k <= yaws; ++k) {
-    left = std::min(left, view[static_cast<std::size_t>(k)]);
-    ok[static_cast<std::size_t>(k)] = left >= floor;
+    const auto ku = static_cast<std::size_t>(k);
+    left = std::min(left, view[ku]);
+    left_miss += miss[ku];
+    turn.ok[ku] = left >= floor;
+    turn.failure[ku] = left_miss;
   }
   double right = kNoView;
+  double right_miss = 0.0;
   for (int k = yaws - 1; 2 * k >= yaws; --k) {
-    right = std::min(right, view[static_cast<std::size_t>(k)]);
+    const auto ku = static_cast<std::size_t>(k);
+    right = std::min(right, view[ku]);
+    right_miss += miss[ku];
     const bool fine = right >= floor;
-    ok[static_cast<std::size_t>(k)] = 2 * k == yaws ? ok[static_cast<std::size_t>(k)] && fine : fine;
+    // Half round: the turn goes either way; both must pass, and the worse sweep counts.
+    turn.ok[ku] = 2 * k == yaws ? turn.ok[ku] && fine : fine;
+    turn.failure[ku] = 2 * k == yaws ? std::max(turn.failure[ku], right_miss) : right_miss;
   }
-  return ok;
+  return turn;
 }
 
 }  // namespace
+
+double failureCost(double probability) { return -std::log(std::max(probability, kMinTrackProbability)); }
 
 void PoseGraphConfig::validate() const {
   require(nominal_speed_mps > 0.0, "nominal_speed_mps", nominal_speed_mps, "must be > 0");
@@ -77,6 +98,7 @@ void PoseGraphConfig::validate() const {
   require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
   require(between_checks >= 0 && between_checks <= 20, "between_checks", between_checks, "must be in [0, 20]");
   require(max_between_rounds >= 1, "max_between_rounds", max_between_rounds, "must be >= 1");
+  require(std::isfinite(failure_weight) && failure_weight >= 0.0, "failure_weight", failure_weight, "must be >= 0");
 }
 
 DagPath shortestLayeredPath(const LayeredDag& dag) {
@@ -165,6 +187,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   // What the camera sees around a layer (V of its path point, any yaw): the image coverage of
   // InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
   const bool gate = information.usesImageCells();
+  const bool inner = information.usesInnerDetections();
   static const std::vector<WeightedPoint> kNone;
   auto segmentAt = [&](double s) {
     int seg = 0;
@@ -185,10 +208,16 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
     cells_of.emplace_back(yaw_of[static_cast<std::size_t>(k)], visibility);
   }
-  const std::vector<bool> turn_ok =
-      free_start && !std::isnan(turn_from_yaw_rad) && config.guard_start_turn && !path.empty()
-          ? startTurnAllowed(path.front(), yaw_of, voxels, visibility, information, config.turn_floor)
-          : std::vector<bool>(static_cast<std::size_t>(yaws), true);
+  // The turn on the spot at the start: guarded (guard_start_turn), and with a model its views'
+  // expected failure added to the first layer's nodes (failure_weight).
+  const bool turns = free_start && !std::isnan(turn_from_yaw_rad) && !path.empty();
+  const bool failures = information.model != nullptr && config.failure_weight > 0.0;
+  StartTurn turn{std::vector<bool>(static_cast<std::size_t>(yaws), true),
+                 std::vector<double>(static_cast<std::size_t>(yaws), 0.0)};
+  if (turns && (config.guard_start_turn || failures)) {
+    turn = sweepStartTurn(path.front(), yaw_of, voxels, visibility, information, config.turn_floor);
+    if (!config.guard_start_turn) turn.ok.assign(turn.ok.size(), true);
+  }
 
   for (int j = 0; j < layers; ++j) {
     const double s = j == layers - 1 ? length : spacing * j;
@@ -264,7 +293,7 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
           }
           computed = true;
           info[idx] += contribution;
-          support[idx].count(pt, range);
+          support[idx].count(pt, range, inner && cells_of[idx].inner(p, pt.p_W));
         });
       }
       for (const WeightedPoint& pt : seen) {
@@ -273,10 +302,14 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       for (int k = 0; k < yaws; ++k) {
         const ViewSupport& backing = support[static_cast<std::size_t>(k)];
         const double score = scoreInformation(info[static_cast<std::size_t>(k)], backing, information);
-        const bool allowed = j != 0 || (free_start ? turn_ok[static_cast<std::size_t>(k)] : k == 0);
+        const bool allowed = j != 0 || (free_start ? turn.ok[static_cast<std::size_t>(k)] : k == 0);
         layer_scores.push_back(score);
-        layer_cost.push_back(allowed ? -config.perception_weight * rankedScore(score, backing, information) / layers
-                                     : kInf);
+        double cost = -config.perception_weight * rankedScore(score, backing, information) / layers;
+        if (failures) {
+          cost += config.failure_weight * (failureCost(information.model->probability(backing)) +
+                                           (j == 0 ? turn.failure[static_cast<std::size_t>(k)] : 0.0));
+        }
+        layer_cost.push_back(allowed ? cost : kInf);
       }
     }
     if (layer_positions.empty() && result.blocked_layer < 0) result.blocked_layer = j;

@@ -209,6 +209,8 @@ class CovisibilityScorer {
     Matrix6d info = Matrix6d::Zero();
     ViewSupport support;
     const double yaw2 = s2->as<Se2State>()->getYaw();
+    const bool inner = config_.information.usesInnerDetections();
+    const ImageCells cells(yaw2, config_.visibility);
     std::size_t i = 0;
     std::size_t j = 0;
     while (i < a.slots.size() && j < b.slots.size()) {
@@ -220,7 +222,7 @@ class CovisibilityScorer {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
         const WeightedPoint point{l.mean_W, static_cast<double>(l.ids.size()), l.normal_W, l.detections};
         addCentredInformation(p2, point.p_W, point.weight, config_.information.bearing_noise_rad, &info);
-        support.count(point, (point.p_W - p2).norm());
+        support.count(point, (point.p_W - p2).norm(), inner && cells.inner(p2, point.p_W));
         ++i;
         ++j;
       }
@@ -228,8 +230,7 @@ class CovisibilityScorer {
     // The image coverage is the camera's at s2: all of its view, not only the common part.
     if (config_.information.usesImageCells()) {
       for (int slot : b.slots) {
-        support.cover(
-            imageCell(p2, yaw2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W, config_.visibility));
+        support.cover(cells(p2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W));
       }
     }
     return scoreInformation(info, support, config_.information);

@@ -7,8 +7,15 @@
 namespace tgnav::planner {
 
 const std::vector<std::string>& trackFeatureNames() {
-  static const std::vector<std::string> names = {"log_detections", "log_landmarks",       "coverage",    "column_span",
-                                                 "row_span",       "log_near_detections", "mean_range_m"};
+  static const std::vector<std::string> names = {"log_detections",
+                                                 "log_landmarks",
+                                                 "coverage",
+                                                 "column_span",
+                                                 "row_span",
+                                                 "log_near_detections",
+                                                 "mean_range_m",
+                                                 "log_inner_detections",
+                                                 "log_inner_near_detections"};
   return names;
 }
 
@@ -39,8 +46,19 @@ double trackFeatureValue(TrackFeature feature, const ViewSupport& support) {
       return std::log1p(support.near_detections);
     case TrackFeature::kMeanRange:
       return support.meanRangeM();
+    case TrackFeature::kLogInnerDetections:
+      return std::log1p(support.inner_detections);
+    case TrackFeature::kLogInnerNearDetections:
+      return std::log1p(support.inner_near_detections);
   }
   return 0.0;
+}
+
+bool TrackModel::uses(TrackFeature feature) const {
+  for (const Term& t : terms) {
+    if (t.feature == feature) return true;
+  }
+  return false;
 }
 
 double TrackModel::probability(const ViewSupport& support) const {

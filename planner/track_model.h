@@ -3,9 +3,11 @@
 // the need of tuning parameters via data-driven methods"): the probability that the VO tracks a
 // frame (at least vo.min_inliers PnP inliers) from what the planner computes for a pose before
 // flying (ViewSupport: the landmarks in view, the detections they promise, how much of the image
-// they cover, how near they are). A logistic model over standardised features,
+// they cover, how near they are, how many fall inside the detector's image border). A logistic
+// model over standardised features,
 //   p = 1 / (1 + exp(-(b + sum_i w_i (f_i - mean_i) / scale_i))),
-// fitted offline by scripts/fit_track_model.py on oracle trials of calibration scenes and read
+// fitted offline by scripts/fit_track_model.py on oracle trials of calibration scenes (by default
+// with the texture features' weights held >= 0, so that more texture never lowers p) and read
 // from its JSON file by the harness (harness/config/track_model_file.h). With a model, a pose
 // scores blind below InformationConfig::min_track_probability (perception.h) in place of the
 // hand-set gates: c_p,thr becomes a probability with a meaning.
@@ -18,13 +20,15 @@ struct ViewSupport;
 
 // What a model may use; the names are the JSON file's and vo.csv's (predicted_<name>).
 enum class TrackFeature {
-  kLogDetections,      // log(1 + detections promised)
-  kLogLandmarks,       // log(1 + landmarks that count)
-  kCoverage,           // share of the image's cells holding a landmark
-  kColumnSpan,         // share of the image's columns holding a landmark
-  kRowSpan,            // share of its rows
-  kLogNearDetections,  // log(1 + detections of landmarks within kNearRangeM)
-  kMeanRange,          // detection-weighted mean range of the landmarks, m (0 when none)
+  kLogDetections,           // log(1 + detections promised)
+  kLogLandmarks,            // log(1 + landmarks that count)
+  kCoverage,                // share of the image's cells holding a landmark
+  kColumnSpan,              // share of the image's columns holding a landmark
+  kRowSpan,                 // share of its rows
+  kLogNearDetections,       // log(1 + detections of landmarks within kNearRangeM)
+  kMeanRange,               // detection-weighted mean range of the landmarks, m (0 when none)
+  kLogInnerDetections,      // log(1 + detections of landmarks in the image's inner part, kImageBorderShare)
+  kLogInnerNearDetections,  // log(1 + detections of landmarks both inner and within kNearRangeM)
 };
 
 const std::vector<std::string>& trackFeatureNames();  // in TrackFeature's order
@@ -54,6 +58,9 @@ struct TrackModel {
   };
   bool has_view_settings = false;
   ViewSettings view_settings;
+
+  // True when a term uses `feature` (callers skip counting what no term reads).
+  bool uses(TrackFeature feature) const;
 
   // The probability that the VO tracks a frame whose view has `support`.
   double probability(const ViewSupport& support) const;

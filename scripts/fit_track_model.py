@@ -4,9 +4,11 @@
 A trial's vo.csv holds, per camera frame, what the VO did (status, inliers) beside the planner's
 view features at the true camera pose (predicted_detections, predicted_landmarks,
 predicted_coverage, predicted_near_detections, predicted_mean_range_m, predicted_column_span,
-predicted_row_span: planner/perception.h's ViewSupport over every landmark of the map in view).
+predicted_row_span, predicted_inner_detections, predicted_inner_near_detections: planner/perception.h's ViewSupport over every
+landmark of the map in view).
 The model is a logistic regression of "the VO tracks this frame" on those features, as
 planner/track_model.h evaluates it; its JSON file is what `planner.information.track_model` reads.
+The texture features' weights are held >= 0 (MONOTONE; --free-signs lets them take either sign).
 
 Frames used: airborne (true z above --min-z), not an initialisation (a frame the VO started or
 restarted on: not lost, no matches). A frame the VO could not restart on is a lost one. Label: tracked with at least min_inliers
@@ -37,12 +39,20 @@ import sys
 import numpy as np
 
 FEATURES = ["log_detections", "log_landmarks", "coverage", "column_span", "row_span", "log_near_detections",
-            "mean_range_m"]
+            "mean_range_m", "log_inner_detections", "log_inner_near_detections"]
 COLUMNS = {"log_detections": "predicted_detections", "log_landmarks": "predicted_landmarks",
            "coverage": "predicted_coverage", "column_span": "predicted_column_span",
            "row_span": "predicted_row_span", "log_near_detections": "predicted_near_detections",
-           "mean_range_m": "predicted_mean_range_m"}
-LOGGED = {"log_detections", "log_landmarks", "log_near_detections"}
+           "mean_range_m": "predicted_mean_range_m", "log_inner_detections": "predicted_inner_detections",
+           "log_inner_near_detections": "predicted_inner_near_detections"}
+LOGGED = {"log_detections", "log_landmarks", "log_near_detections", "log_inner_detections",
+          "log_inner_near_detections"}
+# Features that measure the texture in view: the fit holds their weights >= 0 (unless --free-signs),
+# so that a view never loses probability by showing more. Free, correlated weights extrapolate
+# badly: a fit that weighs coverage up and column span down rates a few textured columns at the
+# image's edge as safe as a view full of texture.
+MONOTONE = {"log_detections", "log_landmarks", "coverage", "column_span", "row_span", "log_near_detections",
+            "log_inner_detections", "log_inner_near_detections"}
 
 
 class InputError(Exception):
@@ -84,7 +94,8 @@ def read_gt_yaw(path):
 
 
 def read_views(folder, views, vo_header, vo_rows):
-    """vo.csv's rows with their predicted_* columns taken from FOLDER/VIEWS (a `tgnav views` CSV)."""
+    """vo.csv's header and rows with their predicted_* columns taken from FOLDER/VIEWS (a `tgnav views`
+    CSV); a column vo.csv lacks (a trial flown before it was logged) is added."""
     path = os.path.join(folder, views)
     if not os.path.isfile(path):
         raise InputError(f"{path}: not found (--views: make it with tgnav views --trial {folder} --out {path})")
@@ -96,16 +107,17 @@ def read_views(folder, views, vo_header, vo_rows):
     if "t" not in header or len(rows) != len(vo_rows):
         raise InputError(f"{path}: {len(rows)} rows against vo.csv's {len(vo_rows)} (not this trial's views)")
     t_vo, t_views = vo_header.index("t"), header.index("t")
+    out_header = list(vo_header) + [n for n in header if n.startswith("predicted_") and n not in vo_header]
     out = []
     for n, (a, b) in enumerate(zip(vo_rows, rows)):
         if len(b) != len(header) or abs(float(a[t_vo]) - float(b[t_views])) > 1e-4:
             raise InputError(f"{path}: line {n + 2} is not vo.csv's frame at t = {a[t_vo]}")
-        row = list(a)
+        row = list(a) + [""] * (len(out_header) - len(vo_header))
         for i, name in enumerate(header):
-            if name.startswith("predicted_") and name in vo_header:
-                row[vo_header.index(name)] = b[i]
+            if name.startswith("predicted_"):
+                row[out_header.index(name)] = b[i]
         out.append(row)
-    return out, settings
+    return out_header, out, settings
 
 
 VIEW_SETTINGS = ["hfov_rad", "vfov_rad", "min_range_m", "max_range_m", "max_incidence_rad"]
@@ -151,7 +163,7 @@ def read_trial(folder, min_z, views=None):
     settings = None
     if views:
         try:
-            rows, settings = read_views(folder, views, header, rows)
+            header, rows, settings = read_views(folder, views, header, rows)
         except ValueError as e:
             raise InputError(f"{os.path.join(folder, views)}: a row does not parse ({e})")
     need = ["t", "status", "matches", "inliers", "x_true", "y_true", "z_true"] + [COLUMNS[n] for n in FEATURES]
@@ -217,14 +229,31 @@ def stack(trials, key):
     return np.concatenate([tr[key] for tr in trials])
 
 
-def fit_logistic(x, y, c):
-    from sklearn.linear_model import LogisticRegression
+def fit_logistic(x, y, c, monotone=None):
+    """L2-regularised logistic regression on standardised features (sklearn's objective:
+    0.5 |w|^2 + c * sum of log losses). `monotone`: one flag per feature; a flagged feature's weight
+    is held >= 0 (more evidence of texture never lowers the probability), by L-BFGS-B bounds."""
+    from scipy.optimize import minimize
     mean = x.mean(axis=0)
     scale = x.std(axis=0)
     scale[scale <= 0] = 1.0
-    model = LogisticRegression(C=c, max_iter=2000)
-    model.fit((x - mean) / scale, y)
-    return mean, scale, model.coef_[0], float(model.intercept_[0])
+    xs = (x - mean) / scale
+    sign = np.where(y, 1.0, -1.0)
+
+    def loss(theta):
+        w, b = theta[:-1], theta[-1]
+        m = sign * (xs @ w + b)
+        # log(1 + exp(-m)) and its derivative, stable for large |m|
+        value = 0.5 * w @ w + c * np.logaddexp(0.0, -m).sum()
+        r = -c * sign * 0.5 * (1.0 - np.tanh(0.5 * m))  # d(c * log loss)/d(score)
+        return value, np.append(w + xs.T @ r, r.sum())
+
+    bounds = [(0.0, None) if monotone is not None and monotone[i] else (None, None) for i in range(x.shape[1])]
+    theta0 = np.zeros(x.shape[1] + 1)
+    theta0[-1] = math.log(max(y.mean(), 1e-9) / max(1.0 - y.mean(), 1e-9))
+    result = minimize(loss, theta0, jac=True, method="L-BFGS-B", bounds=bounds + [(None, None)],
+                      options={"maxiter": 5000, "gtol": 1e-8})
+    return mean, scale, result.x[:-1], float(result.x[-1])
 
 
 def probability(x, mean, scale, weights, intercept):
@@ -237,7 +266,7 @@ def auc(y, p):
     return float(roc_auc_score(y, p)) if 0 < y.sum() < len(y) else float("nan")
 
 
-def leave_one_scene_out(trials, c, with_motion=False):
+def leave_one_scene_out(trials, c, monotone, with_motion=False):
     scenes = sorted({tr["scene"] for tr in trials})
     ys, ps = [], []
     for s in scenes:
@@ -251,7 +280,7 @@ def leave_one_scene_out(trials, c, with_motion=False):
         ytr = stack(train, "y")
         if ytr.min() == ytr.max():
             continue
-        m, sc, w, b = fit_logistic(xtr, ytr, c)
+        m, sc, w, b = fit_logistic(xtr, ytr, c, list(monotone) + [False] * (xtr.shape[1] - len(monotone)))
         ys.append(stack(test, "y"))
         ps.append(probability(xte, m, sc, w, b))
     return auc(np.concatenate(ys), np.concatenate(ps))
@@ -278,10 +307,11 @@ def cmd_fit(args):
             raise InputError(f"{tr['folder']}: view settings {tr['view_settings']} differ from "
                              f"{trials[0]['folder']}'s {settings}: one model is fitted on features counted one way "
                              "(--views)")
-    mean, scale, weights, intercept = fit_logistic(x, y, args.c)
+    monotone = [n in MONOTONE and not args.free_signs for n in names]
+    mean, scale, weights, intercept = fit_logistic(x, y, args.c, monotone)
     train_auc = auc(y, probability(x, mean, scale, weights, intercept))
-    loso = leave_one_scene_out(trials, args.c)
-    loso_motion = leave_one_scene_out(trials, args.c, with_motion=True)
+    loso = leave_one_scene_out(trials, args.c, monotone)
+    loso_motion = leave_one_scene_out(trials, args.c, monotone, with_motion=True)
     scenes = sorted({tr["scene"] for tr in trials})
     threshold, accuracy, flights = choose_threshold(trials, mean, scale, weights, intercept)
     doc = {
@@ -294,7 +324,9 @@ def cmd_fit(args):
                       "trials": len(trials), "frames": int(len(y)), "tracked": int(y.sum()),
                       "views": args.views or "vo.csv",
                       "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"
-                                 + f" --features {','.join(names)}" + (f" --views {args.views}" if args.views else "")},
+                                 + f" --features {','.join(names)}" + (f" --views {args.views}" if args.views else "")
+                                 + (" --free-signs" if args.free_signs else ""),
+                      "weights_held_non_negative": [n for n, m in zip(names, monotone) if m]},
         "scores": {"train_auc": train_auc, "leave_one_scene_out_auc": loso,
                    "leave_one_scene_out_auc_with_motion": loso_motion},
         "suggested_min_track_probability": threshold,
@@ -452,6 +484,8 @@ def main():
     f.add_argument("--out", required=True)
     f.add_argument("--c", type=float, default=1.0, help="inverse L2 regularisation of the logistic regression")
     f.add_argument("--min-z", type=float, default=0.5)
+    f.add_argument("--free-signs", action="store_true",
+                   help="let every weight take either sign (default: the texture features' weights are held >= 0)")
     f.add_argument("--features", default=",".join(FEATURES),
                    help="comma-separated subset of the features the model uses (default: all)")
     e = sub.add_parser("evaluate")

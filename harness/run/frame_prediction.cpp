@@ -27,13 +27,15 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
 
 const char* const kPredictionColumns =
     "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
-    "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_track_probability";
+    "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_inner_detections,"
+    "predicted_inner_near_detections,"
+    "predicted_track_probability";
 
 void writePredictionColumns(std::ostream& out, const FramePrediction& prediction) {
   const planner::ViewSupport& view = prediction.support;
   out << prediction.score << ',' << static_cast<int>(view.landmarks) << ',' << view.coverage() << ',' << view.detections
       << ',' << view.near_detections << ',' << view.meanRangeM() << ',' << view.columnSpan() << ',' << view.rowSpan()
-      << ',';
+      << ',' << view.inner_detections << ',' << view.inner_near_detections << ',';
   if (prediction.track_probability >= 0.0) out << prediction.track_probability;
 }
 

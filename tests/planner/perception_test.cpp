@@ -192,11 +192,41 @@ TEST(ViewSupport, SpansAndRangesOfAView) {
   near_point.detections = 3.0;
   WeightedPoint far_point;
   far_point.detections = 1.0;
-  s.count(near_point, 2.0);
-  s.count(far_point, 8.0);
-  EXPECT_DOUBLE_EQ(s.detections, 4.0);
-  EXPECT_DOUBLE_EQ(s.near_detections, 3.0);  // within kNearRangeM = 3 m
-  EXPECT_DOUBLE_EQ(s.meanRangeM(), (3.0 * 2.0 + 8.0) / 4.0);
+  s.count(near_point, 2.0, false);
+  s.count(far_point, 8.0, true);
+  WeightedPoint near_inner_point;
+  near_inner_point.detections = 0.5;
+  s.count(near_inner_point, 1.0, true);
+  EXPECT_DOUBLE_EQ(s.detections, 4.5);
+  EXPECT_DOUBLE_EQ(s.near_detections, 3.5);  // within kNearRangeM = 3 m
+  EXPECT_DOUBLE_EQ(s.inner_detections, 1.5);
+  EXPECT_DOUBLE_EQ(s.inner_near_detections, 0.5);
+  EXPECT_DOUBLE_EQ(s.meanRangeM(), (3.0 * 2.0 + 8.0 + 0.5 * 1.0) / 4.5);
+}
+
+// The image's inner part: a point counts as inner up to kImageBorderShare of the half-width (and
+// half-height) from the edge, whatever the yaw; behind the camera it is not.
+TEST(ViewSupport, InnerPartIsTheImageLessItsBorder) {
+  VisibilityConfig visibility;
+  const Eigen::Vector3d p(1.0, -2.0, 1.0);
+  const double tan_h = std::tan(0.5 * visibility.hfov_rad);
+  const double tan_v = std::tan(0.5 * visibility.vfov_rad);
+  const double inside = 1.0 - kImageBorderShare - 0.01;
+  const double outside = 1.0 - kImageBorderShare + 0.01;
+  for (double yaw : {0.0, 1.0, -2.5}) {
+    const ImageCells cells(yaw, visibility);
+    const Eigen::Vector3d forward(std::cos(yaw), std::sin(yaw), 0.0);
+    const Eigen::Vector3d left(-std::sin(yaw), std::cos(yaw), 0.0);
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    for (double side : {-1.0, 1.0}) {
+      EXPECT_TRUE(cells.inner(p, p + 4.0 * forward + side * inside * 4.0 * tan_h * left)) << yaw;
+      EXPECT_FALSE(cells.inner(p, p + 4.0 * forward + side * outside * 4.0 * tan_h * left)) << yaw;
+      EXPECT_TRUE(cells.inner(p, p + 2.0 * forward + side * inside * 2.0 * tan_v * up)) << yaw;
+      EXPECT_FALSE(cells.inner(p, p + 2.0 * forward + side * outside * 2.0 * tan_v * up)) << yaw;
+    }
+    EXPECT_TRUE(cells.inner(p, p + 3.0 * forward));
+    EXPECT_FALSE(cells.inner(p, p - 3.0 * forward));
+  }
 }
 
 // A learned model in place of the gates: the probability is the logistic of the standardised
@@ -229,7 +259,21 @@ TEST(TrackModel, ReplacesTheGatesWithAProbability) {
   ViewSupport poorer = poor;
   poorer.detections = 1.0;
   EXPECT_LT(rankedScore(blind, poorer, info), rankedScore(blind, poor, info));
+  EXPECT_TRUE(info.usesImageCells());  // its coverage term
+  EXPECT_FALSE(info.usesInnerDetections());
+  // A model without a term on the image's cells does not need them, whatever the coverage gate
+  // (not used with a model) says; one on the inner detections needs those.
+  TrackModel inner_only;
+  inner_only.terms = {{TrackFeature::kLogInnerDetections, 3.0, 1.0, 2.0}};
+  info.model = std::make_shared<const TrackModel>(inner_only);
+  info.min_image_coverage = 0.5;
+  EXPECT_FALSE(info.usesImageCells());
+  EXPECT_TRUE(info.usesInnerDetections());
+  info.model = nullptr;
   EXPECT_TRUE(info.usesImageCells());
+  EXPECT_FALSE(info.usesInnerDetections());
+  info.min_image_coverage = 0.0;
+  EXPECT_FALSE(info.usesImageCells());
 }
 
 TEST(TrackModel, FeatureNamesRoundTrip) {

@@ -366,55 +366,82 @@ TEST(PoseGraph, WithoutPerceptionThePathIsTheReferenceLine) {
 }
 
 // The graph's per-node information (summed per yaw over an azimuth window) agrees with the
-// direct per-pose computation of perception.h for every chosen pose, whatever the start yaw.
+// direct per-pose computation of perception.h for every chosen pose, whatever the start yaw; so do
+// the inner detections a learned model reads (counted per yaw from the image position), gated
+// where the model's probability falls short.
 TEST(PoseGraph, ChosenScoresMatchPoseScore) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;
-  InformationConfig info;
-  info.min_image_coverage = 0.0;  // information alone (the coverage limit: ImageCoverageGatesOnWhatTheCameraSees)
+  InformationConfig plain;
+  plain.min_image_coverage = 0.0;  // information alone (the coverage limit: ImageCoverageGatesOnWhatTheCameraSees)
+  InformationConfig learned = plain;
+  auto model = std::make_shared<TrackModel>();
+  model->terms = {{TrackFeature::kLogInnerDetections, 3.0, 1.0, 2.0},
+                  {TrackFeature::kLogInnerNearDetections, 2.0, 1.0, 1.0}};
+  learned.model = model;
+  learned.min_track_probability = 0.5;
   const std::vector<PathSegment> segments = extractSegments(
       c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
       [&](int slot) { return c.voxels.landmarksIn(slot); });
+  const double blind = 6.0 * std::log(plain.epsilon);
   int checked = 0;
-  for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
-    const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
-    ASSERT_TRUE(r.found);
-    for (std::size_t j = 0; j < r.path.size(); ++j) {
-      const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
-      const std::vector<WeightedPoint> points = aggregateSlots(c.voxels, seg.covisible);
-      const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
-      EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
-          << "start yaw " << start_yaw << " layer " << j;
-      EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
-      EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
-      ++checked;
+  int gated = 0;
+  int passed = 0;
+  for (const InformationConfig& info : {plain, learned}) {
+    for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
+      const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
+      ASSERT_TRUE(r.found);
+      for (std::size_t j = 0; j < r.path.size(); ++j) {
+        const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
+        const std::vector<WeightedPoint> points = aggregateSlots(c.voxels, seg.covisible);
+        const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
+        EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
+            << "start yaw " << start_yaw << " layer " << j;
+        EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
+        EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
+        ++checked;
+        if (info.model && direct <= blind + 1e-9) ++gated;
+        if (info.model && direct > blind + 1e-9) ++passed;
+      }
     }
   }
-  EXPECT_GT(checked, 50);
+  EXPECT_GT(checked, 100);
+  EXPECT_GT(gated, 0);  // the model decides somewhere, both ways
+  EXPECT_GT(passed, 0);
 }
 
-// A layer is one time step Ts (layers are at most v_nom Ts apart), so whenever validate() passes
-// (2 pi / yaw_samples <= yaw_rate_limit * Ts) the yaw can turn by at least one interval between
-// layers, on any path length. Regression: the allowed turn used to scale with the layer spacing
-// (length / ceil(length / (v_nom Ts))), which froze the yaw on paths whose spacing fell short.
-// Measured by the edge count against a graph whose yaw is frozen (rate limit ~0).
+// Two textured panels facing each other across the start of a path along +x, 2.5 m to either
+// side: A at +y (sparse) and B at -y (denser).
+struct FacingPanels {
+  VoxelMap voxels;
+  std::vector<Eigen::Vector3d> path;
+};
+
+const FacingPanels& facingPanels() {
+  static const FacingPanels panels = [] {
+    testing::SyntheticWorld w;
+    w.min_W = {0.0, 1.5, 0.0};
+    w.max_W = {9.0, 8.5, 2.5};
+    const Eigen::AlignedBox3d a(Eigen::Vector3d(2.0, 7.5, 0.0), Eigen::Vector3d(4.0, 7.8, 2.5));
+    const Eigen::AlignedBox3d b(Eigen::Vector3d(2.0, 2.2, 0.0), Eigen::Vector3d(4.0, 2.5, 2.5));
+    w.solids = {a, b};
+    w.texture(a, Eigen::Vector3d(0, -1, 0), 0.2);
+    w.texture(b, Eigen::Vector3d(0, 1, 0), 0.07);
+    const FeatureMap map = w.build();
+    return FacingPanels{VoxelMap(map, w.min_W, w.max_W), {{3.0, 5.0, kZ}, {7.0, 5.0, kZ}}};
+  }();
+  return panels;
+}
+
 // The turn on the spot at the start (guard_start_turn): two textured panels face each other
 // across the start, 2.5 m to either side of a path along +x; the one behind the vehicle's yaw (-y)
 // is denser, so the unguarded search turns the MAV half round to it, sweeping the blind views
 // along the path. Guarded, every view the turn sweeps (the shorter way, on the yaw lattice)
 // scores at least c_p,thr.
 TEST(PoseGraph, StartTurnNeverSweepsABlindView) {
-  testing::SyntheticWorld w;
-  w.min_W = {0.0, 1.5, 0.0};
-  w.max_W = {9.0, 8.5, 2.5};
-  const Eigen::AlignedBox3d a(Eigen::Vector3d(2.0, 7.5, 0.0), Eigen::Vector3d(4.0, 7.8, 2.5));
-  const Eigen::AlignedBox3d b(Eigen::Vector3d(2.0, 2.2, 0.0), Eigen::Vector3d(4.0, 2.5, 2.5));
-  w.solids = {a, b};
-  w.texture(a, Eigen::Vector3d(0, -1, 0), 0.2);
-  w.texture(b, Eigen::Vector3d(0, 1, 0), 0.07);
-  const FeatureMap map = w.build();
-  const VoxelMap voxels(map, w.min_W, w.max_W);
-  const std::vector<Eigen::Vector3d> path = {{3.0, 5.0, kZ}, {7.0, 5.0, kZ}};
+  const FacingPanels& panels = facingPanels();
+  const VoxelMap& voxels = panels.voxels;
+  const std::vector<Eigen::Vector3d>& path = panels.path;
   const VisibilityConfig vis;
   const InformationConfig info;
   const std::vector<PathSegment> segments = extractSegments(
@@ -456,6 +483,69 @@ TEST(PoseGraph, StartTurnNeverSweepsABlindView) {
   std::cout << "[ figure   ] first yaw unguarded " << u.path.front().yaw_rad << " rad (turn sweeps "
             << weakest_turn(u.path.front().yaw_rad) << "), guarded " << g.path.front().yaw_rad << " rad (turn sweeps "
             << weakest_turn(g.path.front().yaw_rad) << "); c_p " << u.c_p << " -> " << g.c_p << "\n";
+}
+
+// failure_weight, with a learned model: the world of StartTurnNeverSweepsABlindView, unguarded.
+// Without the weight the search turns the MAV half round to the denser panel B, sweeping the views
+// along the path that the model gives little chance; with it, that turn's expected failure
+// (-ln p of every view swept) outweighs B's information and the MAV keeps facing panel A. The
+// chosen path's summed -ln p (nodes and turn) cannot grow with the weight.
+TEST(PoseGraph, FailureWeightAvoidsAStartTurnTheModelDoubts) {
+  const FacingPanels& panels = facingPanels();
+  const VoxelMap& voxels = panels.voxels;
+  const std::vector<Eigen::Vector3d>& path = panels.path;
+  const VisibilityConfig vis;
+  InformationConfig info;
+  auto model = std::make_shared<TrackModel>();
+  model->terms = {{TrackFeature::kLogInnerDetections, std::log1p(20.0), 0.5, 2.0}};  // p = 0.5 at 20
+  info.model = model;
+  info.min_track_probability = 0.5;
+  const std::vector<PathSegment> segments = extractSegments(
+      path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return voxels.landmarksIn(slot); });
+  const std::vector<WeightedPoint> from_start = aggregateByVoxel(voxels, voxels.visibleFrom(path.front(), vis));
+  auto failure = [&](const std::vector<WeightedPoint>& points, const Eigen::Vector3d& p, double yaw) {
+    ViewSupport support;
+    poseInformation(p, yaw, points, vis, info, &support);
+    return failureCost(model->probability(support));
+  };
+  const double vehicle_yaw = M_PI / 2;
+  const double step = 2.0 * M_PI / PoseGraphConfig{}.yaw_samples;
+  // The chosen path's -ln p: its nodes (each with its segment's points, as the search scores
+  // them) and the views its start turn sweeps after the vehicle's own (with all visible).
+  auto path_failure = [&](const PoseGraphResult& r) {
+    double sum = 0.0;
+    for (std::size_t j = 0; j < r.path.size(); ++j) {
+      const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
+      sum += failure(aggregateSlots(voxels, seg.covisible), r.path[j].p_WB, r.path[j].yaw_rad);
+    }
+    const double turn = wrap(r.path.front().yaw_rad - vehicle_yaw);
+    const int steps = static_cast<int>(std::lround(std::abs(turn) / step));
+    for (int k = 1; k <= steps; ++k)
+      sum += failure(from_start, path.front(), vehicle_yaw + std::copysign(k * step, turn));
+    return sum;
+  };
+  ASSERT_GT(failure(from_start, path.front(), 0.0), 5.0);  // along the path: neither panel in view
+  ASSERT_LT(failure(from_start, path.front(), vehicle_yaw), 0.1);
+
+  PoseGraphConfig config;
+  config.guard_start_turn = false;
+  config.between_checks = 0;  // the search alone: its optimum, whose -ln p cannot grow with the weight
+  double last = std::numeric_limits<double>::infinity();
+  std::vector<double> first_yaw;
+  for (double weight : {0.0, 0.01, 0.1, 1.0, 10.0}) {
+    config.failure_weight = weight;
+    const PoseGraphResult r = searchPoseGraph(path, segments, voxels, vis, info, config, std::nan(""), 1, vehicle_yaw);
+    ASSERT_TRUE(r.found);
+    const double f = path_failure(r);
+    EXPECT_LE(f, last + 1e-9) << "weight " << weight;
+    last = f;
+    first_yaw.push_back(r.path.front().yaw_rad);
+    std::cout << "[ figure   ] failure_weight " << weight << ": first yaw " << r.path.front().yaw_rad
+              << " rad, path -ln p " << f << ", c_p " << r.c_p << "\n";
+  }
+  EXPECT_LT(std::sin(first_yaw.front()), 0.0) << "without the weight the denser panel B should win";
+  EXPECT_GT(std::sin(first_yaw.back()), 0.0) << "with it the MAV should keep facing panel A";
 }
 
 // With min_image_coverage, a chosen node scores its co-visible information where the camera's
@@ -599,6 +689,11 @@ TEST(PoseGraph, MovesThatGoBlindBetweenTheirPosesAreAvoidedOrMarked) {
             << forced.c_p << "\n";
 }
 
+// A layer is one time step Ts (layers are at most v_nom Ts apart), so whenever validate() passes
+// (2 pi / yaw_samples <= yaw_rate_limit * Ts) the yaw can turn by at least one interval between
+// layers, on any path length. Regression: the allowed turn used to scale with the layer spacing
+// (length / ceil(length / (v_nom Ts))), which froze the yaw on paths whose spacing fell short.
+// Measured by the edge count against a graph whose yaw is frozen (rate limit ~0).
 TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   const Corridor& c = texturedCorridor(+1);
   const VisibilityConfig vis;

@@ -20,22 +20,26 @@ import numpy as np  # noqa: E402
 
 HEADER = ("t,status,features,with_depth,matches,inliers,keyframe,x_true,y_true,z_true,x_est,y_est,z_est,"
           "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
-          "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_track_probability,"
+          "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_inner_detections,"
+          "predicted_inner_near_detections,"
+          "predicted_track_probability,"
           "ba_correction_m,ba_correction_rad,ba_outliers,keyframe_rule,reason")
 
 
-def write_trial(folder, rng, oracle=-1, detections_scale=1.0):
-    """A trial whose frames are tracked (>= 30 inliers) exactly where the detections exceed 40."""
+def write_trial(folder, rng, oracle=-1, detections_scale=1.0, span_penalty=0.0):
+    """A trial whose frames are tracked (>= 30 inliers) exactly where the detections exceed 40
+    (40 + span_penalty x the column span, drawn at random when span_penalty is set)."""
     os.makedirs(folder)
     rows = []
     for i in range(200):
         det = detections_scale * rng.uniform(0, 120)
-        tracked = det > 40
+        span = rng.uniform(0, 1) if span_penalty else 0.5
+        tracked = det > 40 + span_penalty * span
         inliers = int(30 + det) if tracked else int(det * 0.5)
         status = "ok" if tracked or i == 0 else "lost"  # frame 0: the VO starts (no matches)
         matches = 0 if i == 0 else 50
         rows.append(f"{i * 0.05:.2f},{status},1000,900,{matches},{inliers},0,{i * 0.02:.3f},0,1.0,,,,"
-                    f"-10,{det * 5:.1f},{min(1, det / 150):.3f},{det:.3f},{det / 3:.3f},4.0,0.5,0.5,,,,,,")
+                    f"-10,{det * 5:.1f},{min(1, det / 150):.3f},{det:.3f},{det / 3:.3f},4.0,{span:.3f},0.5,{det * 0.8:.3f},{det / 4:.3f},,,,,,")
     with open(os.path.join(folder, "vo.csv"), "w") as f:
         f.write(HEADER + "\n" + "\n".join(rows) + "\n")
     with open(os.path.join(folder, "config.yaml"), "w") as f:
@@ -88,6 +92,29 @@ class FitTrackModel(unittest.TestCase):
 
     def tearDown(self):
         self.tmp.cleanup()
+
+    def test_texture_weights_are_held_non_negative(self):
+        # tracking here gets harder as the column span grows: a free fit weighs it down, the
+        # default fit holds it at 0 (more texture in view never lowers the probability)
+        calib = os.path.join(self.dir, "calib")
+        rng = np.random.default_rng(3)
+        for s in ["a-1", "a-2", "b-1"]:
+            write_trial(os.path.join(calib, "trials", f"{s}__proposed__s01"), rng, span_penalty=60.0)
+        model = os.path.join(self.dir, "model.json")
+        features = "log_detections,column_span,mean_range_m"
+        r = run("fit", calib, "--out", model, "--features", features)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = read_json(model)
+        weights = dict(zip(doc["features"], doc["weights"]))
+        self.assertEqual(weights["column_span"], 0.0)
+        self.assertGreater(weights["log_detections"], 0.0)
+        self.assertEqual(doc["fitted_on"]["weights_held_non_negative"], ["log_detections", "column_span"])
+        r = run("fit", calib, "--out", model, "--features", features, "--free-signs")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = read_json(model)
+        self.assertLess(dict(zip(doc["features"], doc["weights"]))["column_span"], -0.5)
+        self.assertEqual(doc["fitted_on"]["weights_held_non_negative"], [])
+        self.assertIn("--free-signs", doc["fitted_on"]["command"])
 
     def test_fits_and_evaluates_a_known_rule(self):
         calib = os.path.join(self.dir, "calib")
