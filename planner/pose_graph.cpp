@@ -212,12 +212,13 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   // expected failure added to the first layer's nodes (failure_weight).
   const bool turns = free_start && !std::isnan(turn_from_yaw_rad) && !path.empty();
   const bool failures = information.model != nullptr && config.failure_weight > 0.0;
-  StartTurn turn{std::vector<bool>(static_cast<std::size_t>(yaws), true),
-                 std::vector<double>(static_cast<std::size_t>(yaws), 0.0)};
-  if (turns && (config.guard_start_turn || failures)) {
-    turn = sweepStartTurn(path.front(), yaw_of, voxels, visibility, information, config.turn_floor);
-    if (!config.guard_start_turn) turn.ok.assign(turn.ok.size(), true);
-  }
+  // Unguarded, the sweep's floor is -inf: every yaw is allowed.
+  const StartTurn turn =
+      turns && (config.guard_start_turn || failures)
+          ? sweepStartTurn(path.front(), yaw_of, voxels, visibility, information,
+                           config.guard_start_turn ? config.turn_floor : -std::numeric_limits<double>::infinity())
+          : StartTurn{std::vector<bool>(static_cast<std::size_t>(yaws), true),
+                      std::vector<double>(static_cast<std::size_t>(yaws), 0.0)};
 
   for (int j = 0; j < layers; ++j) {
     const double s = j == layers - 1 ? length : spacing * j;

@@ -166,7 +166,11 @@ class XyGoal : public ob::GoalSampleableRegion {
 class CovisibilityScorer {
  public:
   CovisibilityScorer(const VoxelMap& voxels, const RrtStarConfig& config, double z)
-      : voxels_(voxels), config_(config), z_(z) {}
+      : voxels_(voxels),
+        config_(config),
+        z_(z),
+        cells_(config.information.usesImageCells()),
+        inner_(config.information.usesInnerDetections()) {}
 
   // The landmark voxels of V(p) whose landmarks (aggregated at their mean, as aggregateByVoxel)
   // lie in the field of view at the state's yaw. V(p) is a union of whole landmark voxels, so
@@ -209,7 +213,6 @@ class CovisibilityScorer {
     Matrix6d info = Matrix6d::Zero();
     ViewSupport support;
     const double yaw2 = s2->as<Se2State>()->getYaw();
-    const bool inner = config_.information.usesInnerDetections();
     const ImageCells cells(yaw2, config_.visibility);
     std::size_t i = 0;
     std::size_t j = 0;
@@ -222,13 +225,13 @@ class CovisibilityScorer {
         const LandmarkVoxel& l = voxels_.landmarkVoxels()[static_cast<std::size_t>(a.slots[i])];
         const WeightedPoint point{l.mean_W, static_cast<double>(l.ids.size()), l.normal_W, l.detections};
         addCentredInformation(p2, point.p_W, point.weight, config_.information.bearing_noise_rad, &info);
-        support.count(point, (point.p_W - p2).norm(), inner && cells.inner(p2, point.p_W));
+        support.count(point, (point.p_W - p2).norm(), inner_ && cells.inner(p2, point.p_W));
         ++i;
         ++j;
       }
     }
     // The image coverage is the camera's at s2: all of its view, not only the common part.
-    if (config_.information.usesImageCells()) {
+    if (cells_) {
       for (int slot : b.slots) {
         support.cover(cells(p2, voxels_.landmarkVoxels()[static_cast<std::size_t>(slot)].mean_W));
       }
@@ -271,6 +274,8 @@ class CovisibilityScorer {
   const VoxelMap& voxels_;
   const RrtStarConfig& config_;
   double z_;
+  bool cells_;  // the score needs the image cells (InformationConfig::usesImageCells)
+  bool inner_;  // ... and the inner detections (usesInnerDetections)
   mutable std::unordered_map<Key, View, KeyHash> cache_;
 };
 

@@ -4,8 +4,8 @@
 A trial's vo.csv holds, per camera frame, what the VO did (status, inliers) beside the planner's
 view features at the true camera pose (predicted_detections, predicted_landmarks,
 predicted_coverage, predicted_near_detections, predicted_mean_range_m, predicted_column_span,
-predicted_row_span, predicted_inner_detections, predicted_inner_near_detections: planner/perception.h's ViewSupport over every
-landmark of the map in view).
+predicted_row_span, predicted_inner_detections, predicted_inner_near_detections: planner/perception.h's
+ViewSupport over every landmark of the map in view).
 The model is a logistic regression of "the VO tracks this frame" on those features, as
 planner/track_model.h evaluates it; its JSON file is what `planner.information.track_model` reads.
 The texture features' weights are held >= 0 (MONOTONE; --free-signs lets them take either sign).
@@ -51,8 +51,7 @@ LOGGED = {"log_detections", "log_landmarks", "log_near_detections", "log_inner_d
 # so that a view never loses probability by showing more. Free, correlated weights extrapolate
 # badly: a fit that weighs coverage up and column span down rates a few textured columns at the
 # image's edge as safe as a view full of texture.
-MONOTONE = {"log_detections", "log_landmarks", "coverage", "column_span", "row_span", "log_near_detections",
-            "log_inner_detections", "log_inner_near_detections"}
+MONOTONE = set(FEATURES) - {"mean_range_m"}
 
 
 class InputError(Exception):
@@ -108,14 +107,15 @@ def read_views(folder, views, vo_header, vo_rows):
         raise InputError(f"{path}: {len(rows)} rows against vo.csv's {len(vo_rows)} (not this trial's views)")
     t_vo, t_views = vo_header.index("t"), header.index("t")
     out_header = list(vo_header) + [n for n in header if n.startswith("predicted_") and n not in vo_header]
+    # (views column, output column) of each predicted_* column
+    moves = [(i, out_header.index(name)) for i, name in enumerate(header) if name.startswith("predicted_")]
     out = []
     for n, (a, b) in enumerate(zip(vo_rows, rows)):
         if len(b) != len(header) or abs(float(a[t_vo]) - float(b[t_views])) > 1e-4:
             raise InputError(f"{path}: line {n + 2} is not vo.csv's frame at t = {a[t_vo]}")
         row = list(a) + [""] * (len(out_header) - len(vo_header))
-        for i, name in enumerate(header):
-            if name.startswith("predicted_"):
-                row[out_header.index(name)] = b[i]
+        for i, j in moves:
+            row[j] = b[i]
         out.append(row)
     return out_header, out, settings
 
