@@ -2,8 +2,8 @@
 # Sanitizer and fuzzing checks (Clang from Debian; scripts/setup.sh installs it).
 #
 #   scripts/sanitize.sh [check]              AddressSanitizer + UndefinedBehaviorSanitizer build
-#                                            (build-sanitize/): the unit tests, one smoke trial and
-#                                            one smoke sweep, then every fuzz target replayed and
+#                                            (build-sanitize/): the unit tests, one smoke sweep (two
+#                                            trials) and its report, then every fuzz target replayed and
 #                                            fuzzed for FUZZ_SECONDS (default 20) each. CI runs this.
 #   scripts/sanitize.sh fuzz [TARGET...]     build-sanitize/'s fuzz targets for FUZZ_SECONDS each
 #                                            (default 600), all of them or those named.
@@ -132,7 +132,7 @@ case "$mode" in
     dir="$root/build-sanitize"
     configure "$dir" address,undefined -DTGNAV_FUZZ=ON -DTGNAV_BUILD_TESTS=ON
     # The unit tests: every test program but the closed-loop ones on the paper's scenes (minutes
-    # each at sanitizer speed; the smoke trial and sweep below fly the same code).
+    # each at sanitizer speed; the smoke sweep below flies the same code).
     mapfile -t tests < <(cmake --build "$dir" --target help | sed -n 's/^\.\.\. \(test_[a-z_]*\).*/\1/p' |
       grep -v -E '^test_smoke_|^test_harness_(scene_cache_setup|scene_maps_test|paper_planning_test|scene_trajectory_test|vo_scene_test)$')
     cmake --build "$dir" -j"$jobs" --target tgnav "${tests[@]}"
@@ -141,7 +141,7 @@ case "$mode" in
     # smaller test or the smoke runs below that go through the same code: the property tests over
     # many random maps and warehouse grids (TrajectoryGrid, GridMaps: the other planner tests plan
     # on the same code; the warehouse test alone took 150 s here),
-    # RRT*'s 15000-sample route test, the smoke-map tests (five map builds; the smoke trial below
+    # RRT*'s 15000-sample route test, the smoke-map tests (five map builds; the smoke sweep below
     # builds one), and the sweep runner's Slurm and resume tests (the smoke sweep below).
     slow='TrajectoryGrid\.RandomMaps|GridMaps\.(EveryInflatedPath|Warehouse)|PerceptionRrtStar\.TakesTheLongerTexturedRoute'
     slow+='|SmokeMapTest\.|SweepRunner\.(SlurmBackend|LocalRunResumes)'
@@ -149,6 +149,9 @@ case "$mode" in
     # whose thread-local storage crashed LeakSanitizer's tracer at exit on every run on the
     # development VM ("DTLS ... Tracer caught signal 11"); the normal build runs it.
     slow+='|CliVo\.CorruptImage'
+    # And the report's figures (48 s here, nearly all of it matplotlib, which the sanitizers do not
+    # see): the report of the smoke sweep below draws them through the same code.
+    slow+='|ReportCommand\.DrawsTheFigures'
     # A test that runs tgnav may meet the random tracer crash at the process's exit (lsan_retry):
     # when that is all that failed, the failed tests run once more.
     ctest_log=$(mktemp)
@@ -166,14 +169,14 @@ case "$mode" in
     rm -f "$ctest_log"
     smoke=$(mktemp -d)
     trap 'rm -rf "$smoke"' EXIT
-    lsan_retry "$dir/harness/tgnav" trial --scenario "$root/configs/scenarios/smoke.yaml" --planner proposed --seed 1 \
-      --set camera.width_px=320 --set camera.height_px=240 --map-cache "$smoke/cache" --out "$smoke/trial" --force
+    # The smoke sweep runs each trial as a `tgnav trial` process of this build (a standalone smoke
+    # trial before it flew the same code once more: 60 s of CI).
     printf 'set: {camera.width_px: 320, camera.height_px: 240}\nruns:\n  - {scenario: %s, planner: [proposed, agnostic], seeds: [2]}\n' \
       "$root/configs/scenarios/smoke.yaml" >"$smoke/sweep.yaml"
     lsan_retry "$dir/harness/tgnav" sweep --sweep "$smoke/sweep.yaml" --jobs "$jobs" --map-cache "$smoke/cache" --out "$smoke/sweep"
     lsan_retry "$dir/harness/tgnav" report "$smoke/sweep" --out "$smoke/report" >/dev/null
     fuzz "$dir" "${FUZZ_SECONDS:-20}"
-    echo "sanitize.sh: address,undefined clean: unit tests, smoke trial, smoke sweep and report, $(fuzz_targets | wc -l) fuzz targets"
+    echo "sanitize.sh: address,undefined clean: unit tests, smoke sweep (two trials) and report, $(fuzz_targets | wc -l) fuzz targets"
     ;;
   fuzz)
     build_fuzz "$root/build-sanitize"
