@@ -25,6 +25,11 @@ void VisibilityConfig::validate() const {
   require(vfov_rad > 0.0 && vfov_rad < M_PI, "vfov_rad", vfov_rad, "must be in (0, pi)");
   require(min_range_m >= 0.0, "min_range_m", min_range_m, "must be >= 0");
   require(max_range_m > min_range_m, "max_range_m", max_range_m, "must exceed min_range_m");
+  // >= 0: a yaw whose camera sees a point then also sees it from the body's centre, which lets the
+  // pose graph pick each point's candidate yaws from the body (pose_graph.cpp).
+  require(std::isfinite(camera_forward_m) && camera_forward_m >= 0.0 && camera_forward_m < 1.0, "camera_forward_m",
+          camera_forward_m, "must be in [0, 1)");
+  require(std::isfinite(camera_up_m) && std::abs(camera_up_m) < 1.0, "camera_up_m", camera_up_m, "must be in (-1, 1)");
 }
 
 OccupancyGrid2D sliceOccupancy(const FeatureMap& map, const Eigen::Vector2d& min_xy, const Eigen::Vector2d& max_xy,

@@ -39,6 +39,11 @@ struct VisibilityConfig {
   double vfov_rad = 1.0472;  // 60 deg
   double min_range_m = 0.3;
   double max_range_m = 6.0;
+  // Where the camera sits on the vehicle, in the body frame: this far ahead along the heading and
+  // above the body's centre. The planner's poses are the body's; a view is scored from the camera
+  // (cameraPosition()). 0: from the body's centre, as the paper.
+  double camera_forward_m = 0.0;
+  double camera_up_m = 0.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -47,6 +52,8 @@ struct VisibilityConfig {
     a("vfov_rad", vfov_rad);
     a("min_range_m", min_range_m);
     a("max_range_m", max_range_m);
+    a("camera_forward_m", camera_forward_m);
+    a("camera_up_m", camera_up_m);
   }
 
   void validate() const;

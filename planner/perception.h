@@ -201,6 +201,17 @@ inline bool withinHalfAngle(double opposite, double adjacent, double half_angle,
   return std::atan2(opposite, adjacent) <= half_angle;
 }
 
+// The camera's position when the body is at p_WB heading along yaw_rad (level):
+// VisibilityConfig::camera_forward_m ahead and camera_up_m above.
+inline Eigen::Vector3d cameraPosition(const Eigen::Vector3d& p_WB, double yaw_rad, const VisibilityConfig& visibility) {
+  return {p_WB.x() + visibility.camera_forward_m * std::cos(yaw_rad),
+          p_WB.y() + visibility.camera_forward_m * std::sin(yaw_rad), p_WB.z() + visibility.camera_up_m};
+}
+// True where the camera sits away from the body's centre.
+inline bool cameraOffset(const VisibilityConfig& visibility) {
+  return visibility.camera_forward_m != 0.0 || visibility.camera_up_m != 0.0;
+}
+
 // True if a level camera at p_W looking along yaw_rad sees l_W within range and both FoVs.
 bool inFieldOfView(const Eigen::Vector3d& p_W, double yaw_rad, const Eigen::Vector3d& l_W,
                    const VisibilityConfig& visibility);
@@ -224,7 +235,8 @@ class FieldOfView {
 };
 
 // Summed information (camera-centred frame, fisher.h) of the points in the FoV of the pose that
-// are within the incidence limit; `support` (optional): their weight and image cells.
+// are within the incidence limit; `support` (optional): their weight and image cells. p_W is the
+// camera's position: cameraPosition() of a body pose.
 Matrix6d poseInformation(const Eigen::Vector3d& p_W, double yaw_rad, const std::vector<WeightedPoint>& points,
                          const VisibilityConfig& visibility, const InformationConfig& config,
                          ViewSupport* support = nullptr);

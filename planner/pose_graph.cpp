@@ -48,7 +48,8 @@ StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>
   for (int k = 0; k < yaws; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     ViewSupport support;
-    const Matrix6d info = poseInformation(start, yaw_of[ku], points, visibility, information, &support);
+    const Matrix6d info = poseInformation(cameraPosition(start, yaw_of[ku], visibility), yaw_of[ku], points, visibility,
+                                          information, &support);
     view[ku] = scoreInformation(info, support, information);
     if (information.model) miss[ku] = failureCost(information.model->probability(support));
   }
@@ -203,10 +204,17 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const double tan_half_vfov = std::tan(0.5 * visibility.vfov_rad);
   std::vector<double> yaw_of(static_cast<std::size_t>(yaws));
   std::vector<ImageCells> cells_of;
+  std::vector<FieldOfView> view_of;  // used where the camera sits off the body's centre
+  std::vector<Eigen::Vector3d> camera_of(static_cast<std::size_t>(yaws));  // the camera's offset at each yaw
   cells_of.reserve(static_cast<std::size_t>(yaws));
+  view_of.reserve(static_cast<std::size_t>(yaws));
+  const bool offset = cameraOffset(visibility);
   for (int k = 0; k < yaws; ++k) {
-    yaw_of[static_cast<std::size_t>(k)] = wrapAngle(yaw0 + k * yaw_step);
-    cells_of.emplace_back(yaw_of[static_cast<std::size_t>(k)], visibility);
+    const auto ku = static_cast<std::size_t>(k);
+    yaw_of[ku] = wrapAngle(yaw0 + k * yaw_step);
+    cells_of.emplace_back(yaw_of[ku], visibility);
+    view_of.emplace_back(yaw_of[ku], visibility);
+    camera_of[ku] = cameraPosition(Eigen::Vector3d::Zero(), yaw_of[ku], visibility);
   }
   // The turn on the spot at the start: guarded (guard_start_turn), and with a model its views'
   // expected failure added to the first layer's nodes (failure_weight).
@@ -254,15 +262,21 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     for (const Eigen::Vector3d& p : candidates) {
       if (voxels.clearance(p) < config.robot_radius_m) continue;
       layer_positions.push_back(p);
-      // Calls add(yaw index, d) for each yaw whose field of view holds pt (range, vertical and
-      // horizontal FoV, incidence); only yaws near its azimuth can (all of them when the FoV is
-      // wide compared to the yaw grid).
+      // Calls add(yaw index, camera position) for each yaw whose camera's field of view holds pt
+      // (range, vertical and horizontal FoV, incidence); only yaws near its azimuth can (all of
+      // them when the FoV is wide compared to the yaw grid). A camera ahead of the body's centre
+      // (camera_forward_m >= 0) sees pt only along yaws that would see it from the centre too, so
+      // the centre's window holds them; each is then tested from its own camera position.
       auto forYawsHolding = [&](const WeightedPoint& pt, auto&& add) {
         const Eigen::Vector3d d = pt.p_W - p;
-        const double range = d.norm();
-        if (range < visibility.min_range_m || range > visibility.max_range_m) return;
-        if (!withinIncidence(p, pt, information)) return;
-        if (!withinHalfAngle(std::abs(d.z()), d.head<2>().norm(), 0.5 * visibility.vfov_rad, tan_half_vfov)) return;
+        if (!offset) {
+          const double range = d.norm();
+          if (range < visibility.min_range_m || range > visibility.max_range_m) return;
+          if (!withinIncidence(p, pt, information)) return;
+          if (!withinHalfAngle(std::abs(d.z()), d.head<2>().norm(), 0.5 * visibility.vfov_rad, tan_half_vfov)) {
+            return;
+          }
+        }
         const double azimuth = std::atan2(d.y(), d.x());
         const bool all = 2 * half_window + 1 >= yaws;
         // The window only has to hold every yaw that can see pt (it has a spare yaw each side),
@@ -274,8 +288,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         int idx = first % yaws;
         if (idx < 0) idx += yaws;
         for (int k = first; k <= last; ++k) {
-          if (std::abs(wrapAngle(azimuth - yaw_of[static_cast<std::size_t>(idx)])) <= 0.5 * visibility.hfov_rad) {
-            add(static_cast<std::size_t>(idx));
+          const auto iu = static_cast<std::size_t>(idx);
+          if (!offset) {
+            if (std::abs(wrapAngle(azimuth - yaw_of[iu])) <= 0.5 * visibility.hfov_rad) add(iu, p);
+          } else {
+            const Eigen::Vector3d c = p + camera_of[iu];
+            if (view_of[iu](c, pt.p_W) && withinIncidence(c, pt, information)) add(iu, c);
           }
           if (++idx == yaws) idx = 0;
         }
@@ -287,7 +305,12 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         Matrix6d contribution = Matrix6d::Zero();
         bool computed = false;
         double range = 0.0;
-        forYawsHolding(pt, [&](std::size_t idx) {
+        forYawsHolding(pt, [&](std::size_t idx, const Eigen::Vector3d& c) {
+          if (offset) {  // each yaw's camera is elsewhere
+            addCentredInformation(c, pt.p_W, pt.weight, information.bearing_noise_rad, &info[idx]);
+            support[idx].count(pt, (pt.p_W - c).norm(), inner && cells_of[idx].inner(c, pt.p_W));
+            return;
+          }
           if (!computed) {
             addCentredInformation(p, pt.p_W, pt.weight, information.bearing_noise_rad, &contribution);
             range = (pt.p_W - p).norm();
@@ -298,7 +321,8 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         });
       }
       for (const WeightedPoint& pt : seen) {
-        forYawsHolding(pt, [&](std::size_t idx) { support[idx].cover(cells_of[idx](p, pt.p_W)); });
+        forYawsHolding(
+            pt, [&](std::size_t idx, const Eigen::Vector3d& c) { support[idx].cover(cells_of[idx](c, pt.p_W)); });
       }
       for (int k = 0; k < yaws; ++k) {
         const ViewSupport& backing = support[static_cast<std::size_t>(k)];
@@ -362,15 +386,16 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
       const Eigen::Vector3d p = (1.0 - f) * pa + f * pb;
       const double yaw = wrapAngle(ya + f * turn);
       const double s = (1.0 - f) * result.layer_s[ju] + f * result.layer_s[ju + 1];
+      const Eigen::Vector3d c = cameraPosition(p, yaw, visibility);
       ViewSupport backing;
-      const Matrix6d info = poseInformation(p, yaw, pointsOf(segmentAt(s)), visibility, information, &backing);
+      const Matrix6d info = poseInformation(c, yaw, pointsOf(segmentAt(s)), visibility, information, &backing);
       if (gate) {
         backing.cells = 0;
         const ImageCells cell(yaw, visibility);
         const FieldOfView in_view(yaw, visibility);
         for (const WeightedPoint& pt : layer_seen[2 * i <= config.between_checks + 1 ? ju : ju + 1]) {
-          if (in_view(p, pt.p_W) && withinIncidence(p, pt, information)) {
-            backing.cover(cell(p, pt.p_W));
+          if (in_view(c, pt.p_W) && withinIncidence(c, pt, information)) {
+            backing.cover(cell(c, pt.p_W));
           }
         }
       }

@@ -188,8 +188,8 @@ class CovisibilityScorer {
     // V(p) restricted to the field of view, with the cheap FoV test first: only about a fifth of
     // the voxels in range survive it, and the ray of each survivor is most of the planner's time.
     // The range and vertical-FoV test on the voxel centre is VoxelMap::visibleFrom's own.
-    const Eigen::Vector3d p = position(state, z_);
     const VisibilityConfig& vis = config_.visibility;
+    const Eigen::Vector3d p = cameraPosition(position(state, z_), s->getYaw(), vis);
     const double tan_half_vfov = std::tan(0.5 * vis.vfov_rad);
     View v;
     const std::vector<LandmarkVoxel>& all = voxels_.landmarkVoxels();
@@ -209,10 +209,10 @@ class CovisibilityScorer {
   double edgeScore(const ob::State* s1, const ob::State* s2) const {
     const View& a = view(s1);
     const View& b = view(s2);
-    const Eigen::Vector3d p2 = position(s2, z_);
+    const double yaw2 = s2->as<Se2State>()->getYaw();
+    const Eigen::Vector3d p2 = cameraPosition(position(s2, z_), yaw2, config_.visibility);
     Matrix6d info = Matrix6d::Zero();
     ViewSupport support;
-    const double yaw2 = s2->as<Se2State>()->getYaw();
     const ImageCells cells(yaw2, config_.visibility);
     std::size_t i = 0;
     std::size_t j = 0;
@@ -439,9 +439,10 @@ Plan PerceptionRrtStar::searchTree(const Pose4& start, const Pose4& goal, std::u
   for (const ob::State* state : states) {
     const Eigen::Vector3d p = position(state, z);
     const double yaw = state->as<Se2State>()->getYaw();
-    visible.push_back(voxels_.visibleFrom(p, config_.visibility));
+    const Eigen::Vector3d camera = cameraPosition(p, yaw, config_.visibility);
+    visible.push_back(voxels_.visibleFrom(camera, config_.visibility));
     const double score =
-        poseScore(p, yaw, aggregateByVoxel(voxels_, visible.back()), config_.visibility, config_.information);
+        poseScore(camera, yaw, aggregateByVoxel(voxels_, visible.back()), config_.visibility, config_.information);
     score_sum += score;
     candidate.c_p_min = std::min(candidate.c_p_min, score);
     if (!candidate.path.empty()) candidate.length_m += (p - candidate.path.back().p_WB).norm();

@@ -117,9 +117,9 @@ std::string planRequestLine(const PlanRequestMessage& m) {
                   {"max_speed_m_s", m.max_speed_m_s},
                   {"max_accel_m_s2", m.max_accel_m_s2},
                   {"max_yaw_rate_rad_s", m.max_yaw_rate_rad_s}};
-  j["camera"] = {{"width_px", m.width_px},      {"height_px", m.height_px}, {"rate_hz", m.camera_rate_hz},
-                 {"hfov_rad", m.hfov_rad},      {"vfov_rad", m.vfov_rad},   {"min_range_m", m.min_range_m},
-                 {"max_range_m", m.max_range_m}};
+  j["camera"] = {{"width_px", m.width_px},       {"height_px", m.height_px},        {"rate_hz", m.camera_rate_hz},
+                 {"hfov_rad", m.hfov_rad},       {"vfov_rad", m.vfov_rad},          {"min_range_m", m.min_range_m},
+                 {"max_range_m", m.max_range_m}, {"forward_m", m.camera_forward_m}, {"up_m", m.camera_up_m}};
   j["map"] = {{"octomap", m.octomap},
               {"landmarks", m.landmarks},
               {"occupancy_yaml", m.occupancy_yaml},

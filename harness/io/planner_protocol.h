@@ -43,6 +43,8 @@ struct PlanRequestMessage {
   double vfov_rad = 0.0;
   double min_range_m = 0.0;
   double max_range_m = 0.0;
+  double camera_forward_m = 0.0;  // the camera's position on the body (VisibilityConfig)
+  double camera_up_m = 0.0;
   std::string octomap;  // absolute paths
   std::string landmarks;
   std::string occupancy_yaml;

@@ -98,6 +98,8 @@ PlanRequestMessage requestFor(const Scenario& scenario, const fs::path& map_dir,
   m.vfov_rad = perception.visibility.vfov_rad;
   m.min_range_m = perception.visibility.min_range_m;
   m.max_range_m = perception.visibility.max_range_m;
+  m.camera_forward_m = perception.visibility.camera_forward_m;
+  m.camera_up_m = perception.visibility.camera_up_m;
   m.octomap = fs::absolute(map_dir / "map.bt").string();
   m.landmarks = fs::absolute(map_dir / "landmarks.csv").string();
   m.occupancy_yaml = (tmp / "occupancy.yaml").string();

@@ -384,30 +384,44 @@ TEST(PoseGraph, ChosenScoresMatchPoseScore) {
       c.path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return c.voxels.visibleSlots(p, vis); }, nullptr,
       [&](int slot) { return c.voxels.landmarksIn(slot); });
   const double blind = 6.0 * std::log(plain.epsilon);
+  // The camera off the body's centre (exaggerated to tell the two apart): a pose is scored from
+  // its camera.
+  VisibilityConfig mounted = vis;
+  mounted.camera_forward_m = 0.3;
+  mounted.camera_up_m = 0.1;
   int checked = 0;
   int gated = 0;
   int passed = 0;
-  for (const InformationConfig& info : {plain, learned}) {
-    for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
-      const PoseGraphResult r = searchPoseGraph(c.path, segments, c.voxels, vis, info, PoseGraphConfig{}, start_yaw, 5);
-      ASSERT_TRUE(r.found);
-      for (std::size_t j = 0; j < r.path.size(); ++j) {
-        const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
-        const std::vector<WeightedPoint> points = aggregateSlots(c.voxels, seg.covisible);
-        const double direct = poseScore(r.path[j].p_WB, r.path[j].yaw_rad, points, vis, info);
-        EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
-            << "start yaw " << start_yaw << " layer " << j;
-        EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
-        EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
-        ++checked;
-        if (info.model && direct <= blind + 1e-9) ++gated;
-        if (info.model && direct > blind + 1e-9) ++passed;
+  int moved = 0;  // poses the mounted camera scores otherwise than the body's centre would
+  for (const VisibilityConfig& camera : {vis, mounted}) {
+    for (const InformationConfig& info : {plain, learned}) {
+      for (double start_yaw : {std::nan(""), 0.0, 3.0, -2.9, 1.234}) {
+        const PoseGraphResult r =
+            searchPoseGraph(c.path, segments, c.voxels, camera, info, PoseGraphConfig{}, start_yaw, 5);
+        ASSERT_TRUE(r.found);
+        for (std::size_t j = 0; j < r.path.size(); ++j) {
+          const auto& seg = segments[static_cast<std::size_t>(r.layer_segment[j])];
+          const std::vector<WeightedPoint> points = aggregateSlots(c.voxels, seg.covisible);
+          const double yaw = r.path[j].yaw_rad;
+          const double direct = poseScore(cameraPosition(r.path[j].p_WB, yaw, camera), yaw, points, camera, info);
+          EXPECT_NEAR(r.scores[j], direct, 1e-9 * std::max(1.0, std::abs(direct)))
+              << "start yaw " << start_yaw << " layer " << j << " camera ahead " << camera.camera_forward_m;
+          EXPECT_LE(seg.s_begin_m, r.layer_s[j] + 1e-12);
+          EXPECT_GE(seg.s_end_m, r.layer_s[j] - 1e-12);
+          ++checked;
+          if (info.model && direct <= blind + 1e-9) ++gated;
+          if (info.model && direct > blind + 1e-9) ++passed;
+          if (cameraOffset(camera) && std::abs(direct - poseScore(r.path[j].p_WB, yaw, points, camera, info)) > 1e-6) {
+            ++moved;
+          }
+        }
       }
     }
   }
-  EXPECT_GT(checked, 100);
+  EXPECT_GT(checked, 200);
   EXPECT_GT(gated, 0);  // the model decides somewhere, both ways
   EXPECT_GT(passed, 0);
+  EXPECT_GT(moved, 0);
 }
 
 // Two textured panels facing each other across the start of a path along +x, 2.5 m to either

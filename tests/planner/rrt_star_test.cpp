@@ -161,67 +161,74 @@ TEST(PerceptionRrtStar, PathsAreClearEndToEndAndScoredByCovisibleLandmarks) {
   // The edge scores are recomputed below as the paper defines them; the detections gate is ours
   // (Detectability tests it), and the synthetic map's landmarks are sparse map points.
   config.information.min_detections = 0.0;
-  const PerceptionRrtStar planner(w.voxels, config);
-  for (std::uint64_t seed : {11u, 12u, 13u}) {
-    const Plan plan = planner.solve({w.start, w.goal, seed});
-    ASSERT_EQ(plan.status, PlanStatus::kSolved) << "seed " << seed;
-    ASSERT_EQ(plan.chosen, 0);
-    ASSERT_EQ(plan.candidates.size(), 1u);
-    const CandidatePath& c = plan.candidates[0];
-    ASSERT_EQ(plan.path.size(), c.path.size());
-    ASSERT_GE(c.path.size(), 2u);
-    ASSERT_EQ(c.segments.size(), c.path.size() - 1);
-    EXPECT_EQ(c.path.front().p_WB, w.start.p_WB);
-    EXPECT_EQ(c.path.front().yaw_rad, w.start.yaw_rad);
-    EXPECT_EQ(c.path.back().p_WB, w.goal.p_WB);
-    EXPECT_EQ(c.path.back().yaw_rad, w.goal.yaw_rad);
+  // Views from the body's centre, and from a camera mounted off it (exaggerated): every view is
+  // the camera's (cameraPosition).
+  for (const double ahead : {0.0, 0.3}) {
+    config.visibility.camera_forward_m = ahead;
+    config.visibility.camera_up_m = ahead / 3.0;
+    const PerceptionRrtStar planner(w.voxels, config);
+    auto camera = [&](const Pose4& pose) { return cameraPosition(pose.p_WB, pose.yaw_rad, config.visibility); };
+    for (std::uint64_t seed : {11u, 12u, 13u}) {
+      const Plan plan = planner.solve({w.start, w.goal, seed});
+      ASSERT_EQ(plan.status, PlanStatus::kSolved) << "seed " << seed;
+      ASSERT_EQ(plan.chosen, 0);
+      ASSERT_EQ(plan.candidates.size(), 1u);
+      const CandidatePath& c = plan.candidates[0];
+      ASSERT_EQ(plan.path.size(), c.path.size());
+      ASSERT_GE(c.path.size(), 2u);
+      ASSERT_EQ(c.segments.size(), c.path.size() - 1);
+      EXPECT_EQ(c.path.front().p_WB, w.start.p_WB);
+      EXPECT_EQ(c.path.front().yaw_rad, w.start.yaw_rad);
+      EXPECT_EQ(c.path.back().p_WB, w.goal.p_WB);
+      EXPECT_EQ(c.path.back().yaw_rad, w.goal.yaw_rad);
 
-    double length = 0.0;
-    double edge_cost_sum = 0.0;
-    double last_edge_cost = 0.0;
-    double score_sum = 0.0;
-    double score_min = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < c.path.size(); ++i) {
-      const Pose4& q = c.path[i];
-      EXPECT_EQ(q.p_WB.z(), kFlightZ);
-      const std::vector<int> v = w.voxels.visibleFrom(q.p_WB, config.visibility);
-      const double score =
-          poseScore(q.p_WB, q.yaw_rad, aggregateByVoxel(w.voxels, v), config.visibility, config.information);
-      score_sum += score;
-      score_min = std::min(score_min, score);
-      if (i == 0) continue;
-      const Pose4& p = c.path[i - 1];
-      const ScoredSegment& seg = c.segments[i - 1];
-      EXPECT_TRUE(w.voxels.segmentClear(p.p_WB, q.p_WB, config.robot_radius_m)) << "seed " << seed << " edge " << i;
-      EXPECT_DOUBLE_EQ(seg.s_begin_m, length);
-      length += (q.p_WB - p.p_WB).norm();
-      EXPECT_NEAR(seg.s_end_m, length, 1e-9);
+      double length = 0.0;
+      double edge_cost_sum = 0.0;
+      double last_edge_cost = 0.0;
+      double score_sum = 0.0;
+      double score_min = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < c.path.size(); ++i) {
+        const Pose4& q = c.path[i];
+        EXPECT_EQ(q.p_WB.z(), kFlightZ);
+        const std::vector<int> v = w.voxels.visibleFrom(camera(q), config.visibility);
+        const double score =
+            poseScore(camera(q), q.yaw_rad, aggregateByVoxel(w.voxels, v), config.visibility, config.information);
+        score_sum += score;
+        score_min = std::min(score_min, score);
+        if (i == 0) continue;
+        const Pose4& p = c.path[i - 1];
+        const ScoredSegment& seg = c.segments[i - 1];
+        EXPECT_TRUE(w.voxels.segmentClear(p.p_WB, q.p_WB, config.robot_radius_m)) << "seed " << seed << " edge " << i;
+        EXPECT_DOUBLE_EQ(seg.s_begin_m, length);
+        length += (q.p_WB - p.p_WB).norm();
+        EXPECT_NEAR(seg.s_end_m, length, 1e-9);
 
-      std::vector<int> common;
-      const std::vector<int> u = w.voxels.visibleFrom(p.p_WB, config.visibility);
-      std::set_intersection(u.begin(), u.end(), v.begin(), v.end(), std::back_inserter(common));
-      EXPECT_EQ(seg.covisible, static_cast<int>(common.size()));
-      Matrix6d info = Matrix6d::Zero();
-      for (const WeightedPoint& l : aggregateByVoxel(w.voxels, common)) {
-        if (inFieldOfView(p.p_WB, p.yaw_rad, l.p_W, config.visibility) &&
-            inFieldOfView(q.p_WB, q.yaw_rad, l.p_W, config.visibility)) {
-          addCentredInformation(q.p_WB, l.p_W, l.weight, config.information.bearing_noise_rad, &info);
+        std::vector<int> common;
+        const std::vector<int> u = w.voxels.visibleFrom(camera(p), config.visibility);
+        std::set_intersection(u.begin(), u.end(), v.begin(), v.end(), std::back_inserter(common));
+        EXPECT_EQ(seg.covisible, static_cast<int>(common.size()));
+        Matrix6d info = Matrix6d::Zero();
+        for (const WeightedPoint& l : aggregateByVoxel(w.voxels, common)) {
+          if (inFieldOfView(camera(p), p.yaw_rad, l.p_W, config.visibility) &&
+              inFieldOfView(camera(q), q.yaw_rad, l.p_W, config.visibility)) {
+            addCentredInformation(camera(q), l.p_W, l.weight, config.information.bearing_noise_rad, &info);
+          }
         }
+        const double edge_c = logDetInformation(info, config.information.epsilon);
+        EXPECT_NEAR(seg.c_p, edge_c, 1e-6) << "seed " << seed << " edge " << i;
+        const double rate =
+            config.distance_weight + config.perception_weight / (1.0 + std::exp(edge_c - config.c_p_threshold));
+        last_edge_cost = (q.p_WB - p.p_WB).norm() * rate;
+        edge_cost_sum += last_edge_cost;
       }
-      const double edge_c = logDetInformation(info, config.information.epsilon);
-      EXPECT_NEAR(seg.c_p, edge_c, 1e-6) << "seed " << seed << " edge " << i;
-      const double rate =
-          config.distance_weight + config.perception_weight / (1.0 + std::exp(edge_c - config.c_p_threshold));
-      last_edge_cost = (q.p_WB - p.p_WB).norm() * rate;
-      edge_cost_sum += last_edge_cost;
+      EXPECT_NEAR(c.length_m, length, 1e-9);
+      EXPECT_NEAR(c.c_p, score_sum / static_cast<double>(c.path.size()), 1e-9);
+      EXPECT_DOUBLE_EQ(c.c_p_min, score_min);
+      // The tree's cost: every edge, or every edge but a final step onto the exact goal pose.
+      const bool whole = std::abs(c.cost - edge_cost_sum) < 1e-6;
+      const bool but_last = std::abs(c.cost - (edge_cost_sum - last_edge_cost)) < 1e-6;
+      EXPECT_TRUE(whole || but_last) << "cost " << c.cost << ", edges " << edge_cost_sum;
     }
-    EXPECT_NEAR(c.length_m, length, 1e-9);
-    EXPECT_NEAR(c.c_p, score_sum / static_cast<double>(c.path.size()), 1e-9);
-    EXPECT_DOUBLE_EQ(c.c_p_min, score_min);
-    // The tree's cost: every edge, or every edge but a final step onto the exact goal pose.
-    const bool whole = std::abs(c.cost - edge_cost_sum) < 1e-6;
-    const bool but_last = std::abs(c.cost - (edge_cost_sum - last_edge_cost)) < 1e-6;
-    EXPECT_TRUE(whole || but_last) << "cost " << c.cost << ", edges " << edge_cost_sum;
   }
 }
 

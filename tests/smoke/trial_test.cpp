@@ -454,6 +454,7 @@ TEST(SmokeTrialCli, ViewsRecomputeTheFlownFeatures) {
   // Bad input.
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"--set planner.visibility.max_range_m=-1", "max_range_m"},
+      {"--set planner.visibility.camera_forward_m=-0.1", "camera_forward_m"},
       {"--set planner.no_such_key=1", "no_such_key"},
       {"--out " + (dir / "same.csv").string(), "exists"},
   };
