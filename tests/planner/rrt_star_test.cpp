@@ -158,9 +158,12 @@ TEST(PerceptionRrtStar, PathsAreClearEndToEndAndScoredByCovisibleLandmarks) {
   const TwoRoutes& w = twoRoutes();
   RrtStarConfig config;
   config.samples = 600;
-  // The edge scores are recomputed below as the paper defines them; the detections gate is ours
-  // (Detectability tests it), and the synthetic map's landmarks are sparse map points.
+  // The edge scores are recomputed below as the paper defines them; the detections and coverage
+  // gates are ours (Detectability and the image-coverage tests test them), and the synthetic map's
+  // landmarks are sparse map points. (With the coverage gate on, an edge whose camera sees little
+  // of the map scored blind where the recomputation below does not: clang's build met one.)
   config.information.min_detections = 0.0;
+  config.information.min_image_coverage = 0.0;
   // Views from the body's centre, and from a camera mounted off it (exaggerated): every view is
   // the camera's (cameraPosition).
   for (const double ahead : {0.0, 0.3}) {
