@@ -40,18 +40,24 @@ struct StartTurn {
 };
 
 StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>& yaw_of, const VoxelMap& voxels,
-                         const VisibilityConfig& visibility, const InformationConfig& information, double floor) {
+                         const VisibilityConfig& visibility, const InformationConfig& information, double floor,
+                         int substeps) {
   const int yaws = static_cast<int>(yaw_of.size());
   const std::vector<WeightedPoint> points = aggregateSlots(voxels, voxels.visibleSlots(start, visibility));
-  std::vector<double> view(yaw_of.size());
+  // Every view the turn sweeps, `substeps` per lattice step: view[substeps * k] is yaw_of[k]'s.
+  const int fine = substeps * yaws;
+  const double fine_step = 2.0 * M_PI / fine;
+  std::vector<double> view(static_cast<std::size_t>(fine));
   std::vector<double> miss(yaw_of.size(), 0.0);
-  for (int k = 0; k < yaws; ++k) {
-    const auto ku = static_cast<std::size_t>(k);
+  for (int j = 0; j < fine; ++j) {
+    const double yaw = wrapAngle(yaw_of[0] + j * fine_step);
     ViewSupport support;
-    const Matrix6d info = poseInformation(cameraPosition(start, yaw_of[ku], visibility), yaw_of[ku], points, visibility,
-                                          information, &support);
-    view[ku] = scoreInformation(info, support, information);
-    if (information.model) miss[ku] = failureCost(information.model->probability(support));
+    const Matrix6d info =
+        poseInformation(cameraPosition(start, yaw, visibility), yaw, points, visibility, information, &support);
+    view[static_cast<std::size_t>(j)] = scoreInformation(info, support, information);
+    if (information.model && j % substeps == 0) {
+      miss[static_cast<std::size_t>(j / substeps)] = failureCost(information.model->probability(support));
+    }
   }
   const double kNoView = std::numeric_limits<double>::infinity();
   StartTurn turn{std::vector<bool>(yaw_of.size(), false), std::vector<double>(yaw_of.size(), 0.0)};
@@ -60,7 +66,9 @@ StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>
   double left_miss = 0.0;
   for (int k = 1; 2 * k <= yaws; ++k) {
     const auto ku = static_cast<std::size_t>(k);
-    left = std::min(left, view[ku]);
+    for (int j = substeps * (k - 1) + 1; j <= substeps * k; ++j) {
+      left = std::min(left, view[static_cast<std::size_t>(j)]);
+    }
     left_miss += miss[ku];
     turn.ok[ku] = left >= floor;
     turn.failure[ku] = left_miss;
@@ -69,11 +77,13 @@ StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>
   double right_miss = 0.0;
   for (int k = yaws - 1; 2 * k >= yaws; --k) {
     const auto ku = static_cast<std::size_t>(k);
-    right = std::min(right, view[ku]);
+    for (int j = substeps * k; j < substeps * (k + 1); ++j) {
+      if (j > 0 && j < fine) right = std::min(right, view[static_cast<std::size_t>(j)]);
+    }
     right_miss += miss[ku];
-    const bool fine = right >= floor;
+    const bool fine_turn = right >= floor;
     // Half round: the turn goes either way; both must pass, and the worse sweep counts.
-    turn.ok[ku] = 2 * k == yaws ? turn.ok[ku] && fine : fine;
+    turn.ok[ku] = 2 * k == yaws ? turn.ok[ku] && fine_turn : fine_turn;
     turn.failure[ku] = 2 * k == yaws ? std::max(turn.failure[ku], right_miss) : right_miss;
   }
   return turn;
@@ -98,6 +108,7 @@ void PoseGraphConfig::validate() const {
   require(perception_weight >= 0.0, "perception_weight", perception_weight, "must be >= 0");
   require(robot_radius_m >= 0.0, "robot_radius_m", robot_radius_m, "must be >= 0");
   require(between_checks >= 0 && between_checks <= 20, "between_checks", between_checks, "must be in [0, 20]");
+  require(turn_substeps >= 1 && turn_substeps <= 16, "turn_substeps", turn_substeps, "must be in [1, 16]");
   require(max_between_rounds >= 1, "max_between_rounds", max_between_rounds, "must be >= 1");
   require(std::isfinite(failure_weight) && failure_weight >= 0.0, "failure_weight", failure_weight, "must be >= 0");
 }
@@ -224,7 +235,8 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   const StartTurn turn =
       turns && (config.guard_start_turn || failures)
           ? sweepStartTurn(path.front(), yaw_of, voxels, visibility, information,
-                           config.guard_start_turn ? config.turn_floor : -std::numeric_limits<double>::infinity())
+                           config.guard_start_turn ? config.turn_floor : -std::numeric_limits<double>::infinity(),
+                           config.turn_substeps)
           : StartTurn{std::vector<bool>(static_cast<std::size_t>(yaws), true),
                       std::vector<double>(static_cast<std::size_t>(yaws), 0.0)};
 

@@ -62,6 +62,12 @@ struct PoseGraphConfig {
   // Without it, on generated scenes the search turned the MAV to a first yaw behind it past a bare
   // wall and the VO was lost in every trial on 2 of 4 scenes (docs/results/generalisation).
   bool guard_start_turn = true;
+  // The views the guard checks per lattice step of the turn (ours): 1, the lattice's yaws only;
+  // more, that many evenly spaced per step, the lattice's included. The camera sweeps every yaw in
+  // between, and a textured face can end within one step (15 deg): generated room-1002's start
+  // turn passed, 5 deg past a lattice yaw, a view of a plain face with 5 detections inside the
+  // detector's border, and the VO was lost there on every seed (docs/results/premise/ramps).
+  int turn_substeps = 1;
   double turn_floor = 6.0;  // c_p,thr: set by the planner from its selection config, not a file key
   // Views between the layers (ours; the paper scores the layers' poses only). The MAV flies from
   // one layer's pose to the next over Ts, its position and yaw moving in between, and the VO must
@@ -103,6 +109,7 @@ struct PoseGraphConfig {
     a("robot_radius_m", robot_radius_m);
     a("random_positions", random_positions);
     a("guard_start_turn", guard_start_turn);
+    a("turn_substeps", turn_substeps);
     a("between_checks", between_checks);
     a("max_between_rounds", max_between_rounds);
     a("failure_weight", failure_weight);

@@ -1,5 +1,6 @@
 #include "planner/track_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "planner/perception.h"
@@ -54,6 +55,11 @@ double trackFeatureValue(TrackFeature feature, const ViewSupport& support) {
   return 0.0;
 }
 
+double TrackModel::Term::value(const ViewSupport& support) const {
+  const double f = trackFeatureValue(feature, support);
+  return ramp ? std::clamp((f - ramp_lo) / (ramp_hi - ramp_lo), 0.0, 1.0) : f;
+}
+
 bool TrackModel::uses(TrackFeature feature) const {
   for (const Term& t : terms) {
     if (t.feature == feature) return true;
@@ -63,7 +69,7 @@ bool TrackModel::uses(TrackFeature feature) const {
 
 double TrackModel::probability(const ViewSupport& support) const {
   double z = intercept;
-  for (const Term& t : terms) z += t.weight * (trackFeatureValue(t.feature, support) - t.mean) / t.scale;
+  for (const Term& t : terms) z += t.weight * (t.value(support) - t.mean) / t.scale;
   return 1.0 / (1.0 + std::exp(-z));
 }
 

@@ -4,8 +4,12 @@
 // frame (at least vo.min_inliers PnP inliers) from what the planner computes for a pose before
 // flying (ViewSupport: the landmarks in view, the detections they promise, how much of the image
 // they cover, how near they are, how many fall inside the detector's image border). A logistic
-// model over standardised features,
-//   p = 1 / (1 + exp(-(b + sum_i w_i (f_i - mean_i) / scale_i))),
+// model over standardised terms,
+//   p = 1 / (1 + exp(-(b + sum_i w_i (g_i - mean_i) / scale_i))),
+// where a term's value g_i is its feature f_i, or a ramp of it, clamp((f_i - lo_i) / (hi_i - lo_i), 0, 1)
+// (the file's "ramps", version 2): ramps between consecutive knots with weights >= 0 make p any
+// monotone piecewise-linear function of the feature in the logit, which follows the VO's sharp step
+// from lost to tracked that one straight line cannot.
 // fitted offline by scripts/fit_track_model.py on oracle trials of calibration scenes (by default
 // with the texture features' weights held >= 0, so that more texture never lowers p) and read
 // from its JSON file by the harness (harness/config/track_model_file.h). With a model, a pose
@@ -42,6 +46,10 @@ struct TrackModel {
     double mean = 0.0;
     double scale = 1.0;  // > 0
     double weight = 0.0;
+    bool ramp = false;  // the term is clamp((f - ramp_lo) / (ramp_hi - ramp_lo), 0, 1), ramp_hi > ramp_lo
+    double ramp_lo = 0.0;
+    double ramp_hi = 1.0;
+    double value(const ViewSupport& support) const;
   };
   std::vector<Term> terms;
   double intercept = 0.0;

@@ -9,6 +9,11 @@ ViewSupport over every landmark of the map in view).
 The model is a logistic regression of "the VO tracks this frame" on those features, as
 planner/track_model.h evaluates it; its JSON file is what `planner.information.track_model` reads.
 The texture features' weights are held >= 0 (MONOTONE; --free-signs lets them take either sign).
+--ramps FEATURE=K1,K2,... replaces a feature by ramps between consecutive knots (in the feature's raw
+units: detections for a log_ feature), each clamp((f - lo) / (hi - lo), 0, 1) of the feature's value
+f: with the weights held >= 0 the model is then any monotone piecewise-linear function of it, and not
+only a straight line in the logit (a straight line cannot follow the VO's sharp step from lost to
+tracked between about 10 and 25 detections). A model with ramps is the file's version 2.
 
 Frames used: airborne (true z above --min-z), not an initialisation (a frame the VO started or
 restarted on: not lost, no matches). A frame the VO could not restart on is a lost one. Label: tracked with at least min_inliers
@@ -292,11 +297,51 @@ def select(trials, names):
     return [dict(tr, x=tr["x"][:, cols]) for tr in trials]
 
 
+def parse_ramps(text, names):
+    """--ramps 'FEATURE=K1,K2,...[;FEATURE=...]' as {feature: [knots in the feature's value units]}."""
+    out = {}
+    for item in [i for i in (text or "").split(";") if i.strip()]:
+        name, _, knots = item.partition("=")
+        name = name.strip()
+        if name not in names:
+            raise InputError(f"--ramps: '{name}' is not one of the model's features ({', '.join(names)})")
+        try:
+            raw = [float(k) for k in knots.split(",")]
+        except ValueError:
+            raise InputError(f"--ramps: '{item}' does not parse (FEATURE=K1,K2,...)")
+        if len(raw) < 2 or any(b <= a for a, b in zip(raw, raw[1:])) or (name in LOGGED and raw[0] <= -1):
+            raise InputError(f"--ramps: '{item}' needs two or more increasing knots")
+        out[name] = [math.log1p(k) for k in raw] if name in LOGGED else raw
+    return out
+
+
+def model_terms(names, ramps):
+    """(feature name, column in names, (lo, hi) or None) for each term of the model."""
+    terms = []
+    for i, n in enumerate(names):
+        knots = ramps.get(n)
+        if knots:
+            terms += [(n, i, (lo, hi)) for lo, hi in zip(knots, knots[1:])]
+        else:
+            terms.append((n, i, None))
+    return terms
+
+
+def design(x, terms):
+    """The model's term values from the named feature columns x."""
+    cols = []
+    for _, i, ramp in terms:
+        v = x[:, i]
+        cols.append(v if ramp is None else np.clip((v - ramp[0]) / (ramp[1] - ramp[0]), 0.0, 1.0))
+    return np.column_stack(cols)
+
+
 def cmd_fit(args):
     names = [n for n in args.features.split(",") if n]
     unknown = [n for n in names if n not in FEATURES]
     if unknown or not names:
         raise InputError(f"--features: '{unknown[0] if unknown else args.features}' is not one of {', '.join(FEATURES)}")
+    terms = model_terms(names, parse_ramps(args.ramps, names))
     trials = select(read_sweeps(args.sweeps, args.min_z, args.views), names)
     x, y = stack(trials, "x"), stack(trials, "y")
     if y.min() == y.max():
@@ -307,17 +352,25 @@ def cmd_fit(args):
             raise InputError(f"{tr['folder']}: view settings {tr['view_settings']} differ from "
                              f"{trials[0]['folder']}'s {settings}: one model is fitted on features counted one way "
                              "(--views)")
-    monotone = [n in MONOTONE and not args.free_signs for n in names]
+    trials = [dict(tr, x=design(tr["x"], terms)) for tr in trials]
+    x = stack(trials, "x")
+    # a ramp is monotone in its feature: held >= 0 with it (a ramp of mean_range_m too)
+    monotone = [(n in MONOTONE or r is not None) and not args.free_signs for n, _, r in terms]
     mean, scale, weights, intercept = fit_logistic(x, y, args.c, monotone)
     train_auc = auc(y, probability(x, mean, scale, weights, intercept))
     loso = leave_one_scene_out(trials, args.c, monotone)
     loso_motion = leave_one_scene_out(trials, args.c, monotone, with_motion=True)
     scenes = sorted({tr["scene"] for tr in trials})
     threshold, accuracy, flights = choose_threshold(trials, mean, scale, weights, intercept)
+    has_ramps = any(r is not None for _, _, r in terms)
     doc = {
-        "format": "tgnav-track-model", "version": 1, "kind": "logistic",
+        "format": "tgnav-track-model", "version": 2 if has_ramps else 1, "kind": "logistic",
         "label": "the VO tracks the frame with at least vo.min_inliers PnP inliers",
-        "features": names, "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
+        "features": [n for n, _, _ in terms]}
+    if has_ramps:
+        doc["ramps"] = [list(r) if r is not None else None for _, _, r in terms]
+    doc.update({
+        "mean": mean.tolist(), "scale": scale.tolist(), "weights": weights.tolist(),
         "intercept": intercept,
         "view_settings": settings,
         "fitted_on": {"sweeps": [os.path.normpath(d) for d in args.sweeps], "scenes": scenes,
@@ -325,13 +378,14 @@ def cmd_fit(args):
                       "views": args.views or "vo.csv",
                       "command": "scripts/fit_track_model.py fit " + " ".join(args.sweeps) + f" --c {args.c}"
                                  + f" --features {','.join(names)}" + (f" --views {args.views}" if args.views else "")
+                                 + (f" --ramps '{args.ramps}'" if args.ramps else "")
                                  + (" --free-signs" if args.free_signs else ""),
-                      "weights_held_non_negative": [n for n, m in zip(names, monotone) if m]},
+                      "weights_held_non_negative": list(dict.fromkeys(n for (n, _, _), m in zip(terms, monotone) if m))},
         "scores": {"train_auc": train_auc, "leave_one_scene_out_auc": loso,
                    "leave_one_scene_out_auc_with_motion": loso_motion},
         "suggested_min_track_probability": threshold,
         "class_flyable_accuracy_there": accuracy, "oracle_trials": flights,
-    }
+    })
     text = json.dumps(doc, indent=2) + "\n"
     tmp = args.out + ".tmp"
     with open(tmp, "w") as f:
@@ -340,8 +394,9 @@ def cmd_fit(args):
     print(f"fitted on {len(trials)} trials of {len(scenes)} scenes, {len(y)} frames ({int(y.sum())} tracked): "
           f"training AUC {train_auc:.3f}, leave-one-scene-out AUC {loso:.3f} "
           f"(with speed and yaw rate {loso_motion:.3f}) -> {args.out}")
-    for n, w in zip(names, weights):
-        print(f"  {n:22s} weight {w:+.3f}")
+    for (n, _, r), w in zip(terms, weights):
+        where = f" ramp {r[0]:.3f}..{r[1]:.3f}" if r is not None else ""
+        print(f"  {n:22s}{where} weight {w:+.3f}")
     print(f"  class flyable (every frame at or above p) on its {flights} oracle trials: best p = {threshold:.2f}, "
           f"{accuracy:.3f} right")
 
@@ -384,9 +439,15 @@ def load_model(path):
     for key in ("mean", "scale", "weights", "intercept"):
         if key not in doc:
             raise InputError(f"{path}: key '{key}' is missing")
+    ramps = doc.get("ramps", [None] * len(features))
+    if not isinstance(ramps, list) or len(ramps) != len(features) or any(
+            r is not None and (not isinstance(r, list) or len(r) != 2 or not r[1] > r[0]) for r in ramps):
+        raise InputError(f"{path}: key 'ramps' has value '{ramps}', expected null or [lo, hi] per feature")
+    names = list(dict.fromkeys(features))  # the distinct features, in order
+    terms = [(n, names.index(n), tuple(r) if r is not None else None) for n, r in zip(features, ramps)]
     with open(path, "rb") as f:
         sha = hashlib.sha256(f.read()).hexdigest()[:16]
-    return (features, np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]),
+    return (names, terms, np.array(doc["mean"]), np.array(doc["scale"]), np.array(doc["weights"]),
             float(doc["intercept"]), sha)
 
 
@@ -401,7 +462,7 @@ def reliability(y, p, bins=10):
 
 
 def cmd_evaluate(args):
-    names, mean, scale, weights, intercept, sha = load_model(args.model)
+    names, terms, mean, scale, weights, intercept, sha = load_model(args.model)
     all_trials = read_sweeps(args.sweeps, args.min_z, args.views)
     with open(args.model) as f:
         fitted = json.load(f).get("view_settings")
@@ -409,7 +470,7 @@ def cmd_evaluate(args):
         if tr["view_settings"] != {k: float(fitted.get(k, float("nan"))) for k in VIEW_SETTINGS}:
             raise InputError(f"{tr['folder']}: its features were counted with {tr['view_settings']}, the model "
                              f"{args.model} with {fitted} (--views: features computed again with the model's settings)")
-    trials = select(all_trials, names)
+    trials = [dict(tr, x=design(tr["x"], terms)) for tr in select(all_trials, names)]
     for tr in trials:
         tr["p"] = probability(tr["x"], mean, scale, weights, intercept)
     y, p = stack(trials, "y"), stack(trials, "p")
@@ -488,6 +549,8 @@ def main():
                    help="let every weight take either sign (default: the texture features' weights are held >= 0)")
     f.add_argument("--features", default=",".join(FEATURES),
                    help="comma-separated subset of the features the model uses (default: all)")
+    f.add_argument("--ramps", help="FEATURE=K1,K2,...[;FEATURE=...]: that feature as monotone ramps between "
+                                   "consecutive knots (raw units: detections for a log_ feature)")
     e = sub.add_parser("evaluate")
     e.add_argument("sweeps", nargs="+")
     e.add_argument("--model", required=True)

@@ -60,8 +60,8 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
     fail(file, "key 'format' has value '" + format.dump() + "', expected \"tgnav-track-model\"");
   }
   const Json& version = member(file, doc, "version");
-  if (version != 1) {
-    fail(file, "key 'version' has value '" + version.dump() + "', expected 1 (this build reads version 1)");
+  if (version != 1 && version != 2) {
+    fail(file, "key 'version' has value '" + version.dump() + "', expected 1 or 2 (this build reads versions 1-2)");
   }
   const Json& kind = member(file, doc, "kind");
   if (kind != "logistic") fail(file, "key 'kind' has value '" + kind.dump() + "', expected \"logistic\"");
@@ -75,6 +75,16 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
   const std::vector<double> mean = numbers(file, doc, "mean", n);
   const std::vector<double> scale = numbers(file, doc, "scale", n);
   const std::vector<double> weights = numbers(file, doc, "weights", n);
+  // Version 2 may give a term a ramp of its feature; version 1 has none (an older reader would
+  // take the feature itself, so a file with ramps must say version 2).
+  const auto ramps = doc.find("ramps");
+  if (ramps != doc.end()) {
+    if (version != 2) fail(file, "key 'ramps' needs version 2, the file says " + version.dump());
+    if (!ramps->is_array() || ramps->size() != n) {
+      fail(file, "key 'ramps' has value '" + ramps->dump().substr(0, 80) + "', expected an array of " +
+                     std::to_string(n) + " entries (null or [lo, hi], one per feature)");
+    }
+  }
   for (std::size_t i = 0; i < n; ++i) {
     planner::TrackModel::Term term;
     const std::string key = "features[" + std::to_string(i) + "]";
@@ -89,6 +99,19 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
     term.mean = mean[i];
     term.scale = scale[i];
     term.weight = weights[i];
+    if (ramps != doc.end() && !(*ramps)[i].is_null()) {
+      const Json& r = (*ramps)[i];
+      const std::string rkey = "ramps[" + std::to_string(i) + "]";
+      if (!r.is_array() || r.size() != 2) {
+        fail(file, "key '" + rkey + "' has value '" + r.dump().substr(0, 80) + "', expected null or [lo, hi]");
+      }
+      term.ramp = true;
+      term.ramp_lo = number(file, r[0], rkey + "[0]");
+      term.ramp_hi = number(file, r[1], rkey + "[1]");
+      if (!(term.ramp_hi > term.ramp_lo)) {
+        fail(file, "key '" + rkey + "' has value '" + r.dump() + "', expected lo < hi");
+      }
+    }
     model.terms.push_back(term);
   }
   model.intercept = number(file, member(file, doc, "intercept"), "intercept");

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -40,6 +41,38 @@ TEST(TrackModelFile, ReadsAGoodFile) {
   EXPECT_NEAR(m.probability(s), 1.0 / (1.0 + std::exp(-(0.25 - 0.5))), 1e-12);
 }
 
+// Version 2: a term may be a ramp of its feature, clamp((f - lo) / (hi - lo), 0, 1); one feature
+// may then appear in several terms (a monotone piecewise-linear logit).
+const char* kRamps = R"({"format": "tgnav-track-model", "version": 2, "kind": "logistic",
+  "features": ["log_inner_detections", "log_inner_detections", "mean_range_m"],
+  "ramps": [[1.0, 2.0], [2.0, 4.0], null], "mean": [0.5, 0.25, 3.0], "scale": [0.5, 0.25, 2.0],
+  "weights": [1.5, 2.0, -0.5], "intercept": 0.5})";
+
+TEST(TrackModelFile, ReadsAndEvaluatesRamps) {
+  const auto file = test::writeFile(test::tempDir() / "ramps.json", kRamps);
+  const planner::TrackModel m = loadTrackModel(file);
+  ASSERT_EQ(m.terms.size(), 3u);
+  EXPECT_TRUE(m.terms[0].ramp);
+  EXPECT_EQ(m.terms[1].ramp_lo, 2.0);
+  EXPECT_EQ(m.terms[1].ramp_hi, 4.0);
+  EXPECT_FALSE(m.terms[2].ramp);
+  const auto p = [&](double log_inner, double range_m) {
+    planner::ViewSupport s;
+    s.inner_detections = std::expm1(log_inner);
+    s.detections = s.inner_detections;  // the mean range is detection-weighted
+    s.range_detections = range_m * s.detections;
+    const double r1 = std::clamp(log_inner - 1.0, 0.0, 1.0);
+    const double r2 = std::clamp((log_inner - 2.0) / 2.0, 0.0, 1.0);
+    const double z = 0.5 + 1.5 * (r1 - 0.5) / 0.5 + 2.0 * (r2 - 0.25) / 0.25 - 0.5 * (range_m - 3.0) / 2.0;
+    EXPECT_NEAR(m.probability(s), 1.0 / (1.0 + std::exp(-z)), 1e-12) << log_inner;
+    return m.probability(s);
+  };
+  // below the first knot and above the last, the ramps are flat: more texture changes nothing there
+  EXPECT_NEAR(p(0.2, 3.0), p(0.9, 3.0), 1e-12);
+  EXPECT_NEAR(p(4.5, 3.0), p(6.0, 3.0), 1e-12);
+  EXPECT_LT(p(1.5, 3.0), p(3.0, 3.0));
+}
+
 TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
   const auto dir = test::tempDir();
   const std::string good = kGood;
@@ -52,7 +85,16 @@ TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
       {"{", "not JSON"},
       {"[1, 2]", "expected a JSON object"},
       {with("\"tgnav-track-model\"", "\"other\""), "key 'format' has value '\"other\"'"},
-      {with("\"version\": 1", "\"version\": 2"), "key 'version' has value '2'"},
+      {with("\"version\": 1", "\"version\": 3"), "key 'version' has value '3', expected 1 or 2"},
+      {with("\"weights\"", "\"ramps\": [null, [0, 1]], \"weights\""), "key 'ramps' needs version 2"},
+      {with("\"version\": 1", "\"version\": 2").replace(good.find("\"weights\""), 0, "\"ramps\": [null], "),
+       "key 'ramps' has value '[null]', expected an array of 2 entries"},
+      {with("\"version\": 1", "\"version\": 2").replace(good.find("\"weights\""), 0, "\"ramps\": [null, [1, 1]], "),
+       "key 'ramps[1]' has value '[1,1]', expected lo < hi"},
+      {with("\"version\": 1", "\"version\": 2").replace(good.find("\"weights\""), 0, "\"ramps\": [null, [1]], "),
+       "key 'ramps[1]' has value '[1]', expected null or [lo, hi]"},
+      {with("\"version\": 1", "\"version\": 2").replace(good.find("\"weights\""), 0, "\"ramps\": [null, [1, \"x\"]], "),
+       "key 'ramps[1][1]' has value '\"x\"', expected a number"},
       {with("\"logistic\"", "\"tree\""), "key 'kind' has value '\"tree\"'"},
       {with("\"coverage\"]", "\"colour\"]"),
        "key 'features[1]' has value '\"colour\"', expected one of log_detections"},

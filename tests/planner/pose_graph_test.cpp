@@ -499,6 +499,65 @@ TEST(PoseGraph, StartTurnNeverSweepsABlindView) {
             << weakest_turn(g.path.front().yaw_rad) << "); c_p " << u.c_p << " -> " << g.c_p << "\n";
 }
 
+// turn_substeps: a plain box 0.6 m north of the start leaves the views of two narrow windows of
+// yaws (about 84-87 and 93-96 deg) too little of the textured walls beyond its edges; both lie
+// between yaws of the lattice (from the vehicle's 150 deg: 105, 90, 75). On the lattice alone the
+// guard lets the MAV turn east, to the path's heading, and the camera sweeps a window. Checked at 4
+// views per step the guard sees it: the turn it allows sweeps no view below the floor (checked at
+// 1 deg), and the MAV turns the other way round, to the textured west wall.
+TEST(PoseGraph, StartTurnSubstepsSeeABlindWindowBetweenLatticeYaws) {
+  testing::SyntheticWorld w;
+  w.min_W = {0.0, 0.0, 0.0};
+  w.max_W = {7.0, 7.0, 2.5};
+  const Eigen::AlignedBox3d north(Eigen::Vector3d(0.0, 6.7, 0.0), Eigen::Vector3d(7.0, 7.0, 2.5));
+  const Eigen::AlignedBox3d south(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(7.0, 0.3, 2.5));
+  const Eigen::AlignedBox3d west(Eigen::Vector3d(0.0, 0.3, 0.0), Eigen::Vector3d(0.3, 6.7, 2.5));
+  const Eigen::AlignedBox3d east(Eigen::Vector3d(6.7, 0.3, 0.0), Eigen::Vector3d(7.0, 6.7, 2.5));
+  // plain, from the start (3.5, 3.5): 59.5 to 120.5 deg
+  const Eigen::AlignedBox3d plain(Eigen::Vector3d(3.146, 4.1, 0.0), Eigen::Vector3d(3.853, 5.1, 2.5));
+  w.solids = {north, south, west, east, plain};
+  w.texture(north, Eigen::Vector3d(0, -1, 0), 0.1);
+  w.texture(west, Eigen::Vector3d(1, 0, 0), 0.1);
+  w.texture(east, Eigen::Vector3d(-1, 0, 0), 0.1);
+  const FeatureMap map = w.build();
+  const VoxelMap voxels(map, w.min_W, w.max_W);
+  const std::vector<Eigen::Vector3d> path = {{3.5, 3.5, kZ}, {6.0, 3.5, kZ}};
+  const VisibilityConfig vis;
+  const InformationConfig info = syntheticInformation();
+  const std::vector<PathSegment> segments = extractSegments(
+      path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return voxels.landmarksIn(slot); });
+  const std::vector<WeightedPoint> from_start = aggregateByVoxel(voxels, voxels.visibleFrom(path.front(), vis));
+  auto view = [&](double yaw) { return poseScore(path.front(), yaw, from_start, vis, info); };
+  const double deg = M_PI / 180.0;
+  const double vehicle_yaw = 150.0 * deg;
+  const double floor = 6.0;
+  ASSERT_LT(view(95.0 * deg), floor);
+  ASSERT_LT(view(86.0 * deg), floor);
+  for (int a : {150, 135, 120, 105, 90, 75, 60, 45, 30, 15, 0}) ASSERT_GE(view(a * deg), floor) << a << " deg";
+  // The weakest view the turn to `yaw` sweeps, the shorter way round, at 1 deg.
+  auto weakest_turn = [&](double yaw) {
+    const double turn = wrap(yaw - vehicle_yaw);
+    const int steps = static_cast<int>(std::lround(std::abs(turn) / deg));
+    double weakest = view(vehicle_yaw);
+    for (int k = 1; k <= steps; ++k) weakest = std::min(weakest, view(vehicle_yaw + std::copysign(k * deg, turn)));
+    return weakest;
+  };
+  PoseGraphConfig lattice;
+  lattice.turn_floor = floor;
+  const PoseGraphResult a = searchPoseGraph(path, segments, voxels, vis, info, lattice, std::nan(""), 1, vehicle_yaw);
+  PoseGraphConfig fine = lattice;
+  fine.turn_substeps = 4;
+  const PoseGraphResult b = searchPoseGraph(path, segments, voxels, vis, info, fine, std::nan(""), 1, vehicle_yaw);
+  ASSERT_TRUE(a.found);
+  ASSERT_TRUE(b.found);
+  EXPECT_LT(weakest_turn(a.path.front().yaw_rad), floor) << "the lattice's guard should let the turn east pass";
+  EXPECT_GE(weakest_turn(b.path.front().yaw_rad), floor) << "first yaw " << b.path.front().yaw_rad / deg << " deg";
+  std::cout << "[ figure   ] first yaw on the lattice " << a.path.front().yaw_rad / deg << " deg (weakest view swept "
+            << weakest_turn(a.path.front().yaw_rad) << "), at 4 views per step " << b.path.front().yaw_rad / deg
+            << " deg (" << weakest_turn(b.path.front().yaw_rad) << ")\n";
+}
+
 // failure_weight, with a learned model: the world of StartTurnNeverSweepsABlindView, unguarded.
 // Without the weight the search turns the MAV half round to the denser panel B, sweeping the views
 // along the path that the model gives little chance; with it, that turn's expected failure
@@ -786,6 +845,13 @@ TEST(PoseGraph, ConfigValidationNamesTheField) {
   c = PoseGraphConfig{};
   c.max_between_rounds = 0;
   expectRejected(c, "max_between_rounds");
+  c = PoseGraphConfig{};
+  c.turn_substeps = 0;
+  expectRejected(c, "turn_substeps");
+  c.turn_substeps = 17;
+  expectRejected(c, "turn_substeps");
+  c.turn_substeps = 16;
+  EXPECT_NO_THROW(c.validate());
 }
 
 }  // namespace

@@ -155,6 +155,55 @@ class FitTrackModel(unittest.TestCase):
         self.assertEqual(cf["tn"], 4)
         self.assertTrue(os.path.isfile(os.path.join(out, "reliability.png")))
 
+    def test_ramps_fit_a_monotone_step(self):
+        # tracked exactly above 40 detections: ramps between knots follow the step, and every
+        # ramp's weight is held >= 0, so the probability never falls as detections grow
+        calib = os.path.join(self.dir, "calib")
+        held = os.path.join(self.dir, "held")
+        make_sweep(calib, ["a-1", "a-2", "b-1"], 1)
+        make_sweep(held, ["c-1", "c-2"], 2)
+        model = os.path.join(self.dir, "ramps.json")
+        knots = [10, 20, 30, 40, 50, 60, 80, 120]
+        r = run("fit", calib, "--out", model, "--features", "log_detections,mean_range_m",
+                "--ramps", "log_detections=" + ",".join(map(str, knots)))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        doc = read_json(model)
+        self.assertEqual(doc["version"], 2)
+        self.assertEqual(doc["features"], ["log_detections"] * (len(knots) - 1) + ["mean_range_m"])
+        self.assertEqual(len(doc["ramps"]), len(doc["features"]))
+        self.assertIsNone(doc["ramps"][-1])
+        self.assertAlmostEqual(doc["ramps"][0][0], np.log1p(10))
+        self.assertAlmostEqual(doc["ramps"][-2][1], np.log1p(120))
+        self.assertTrue(all(w >= 0 for w in doc["weights"][:-1]))
+        self.assertIn("--ramps", doc["fitted_on"]["command"])
+
+        def p(detections):
+            z = doc["intercept"]
+            for name, ramp, m, sc, w in zip(doc["features"], doc["ramps"], doc["mean"], doc["scale"], doc["weights"]):
+                f = np.log1p(detections) if name == "log_detections" else 4.0
+                if ramp is not None:
+                    f = min(max((f - ramp[0]) / (ramp[1] - ramp[0]), 0.0), 1.0)
+                z += w * (f - m) / sc
+            return 1.0 / (1.0 + np.exp(-z))
+        grid = [p(d) for d in range(0, 130, 2)]
+        self.assertTrue(all(b >= a - 1e-12 for a, b in zip(grid, grid[1:])))
+        self.assertLess(p(30), 0.2)
+        self.assertGreater(p(50), 0.8)
+        out = os.path.join(self.dir, "eval")
+        r = run("evaluate", held, "--model", model, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertGreater(read_json(os.path.join(out, "evaluation.json"))["roc_auc"], 0.95)
+        for bad, says in [("log_detections=10", "two or more increasing knots"),
+                          ("log_detections=20,10", "two or more increasing knots"),
+                          ("log_detections=a,b", "does not parse"),
+                          ("coverage=0.1,0.2", "'coverage' is not one of the model's features")]:
+            r = run("fit", calib, "--out", os.path.join(self.dir, "bad.json"), "--features",
+                    "log_detections,mean_range_m", "--ramps", bad)
+            self.assertEqual(r.returncode, 2, bad)
+            self.assertIn(says, r.stderr)
+            self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+            self.assertFalse(os.path.exists(os.path.join(self.dir, "bad.json")))
+
     def test_bad_input_is_one_line_and_exit_2(self):
         calib = os.path.join(self.dir, "calib")
         make_sweep(calib, ["a-1"], 1)
