@@ -38,7 +38,8 @@ struct VisibilityConfig {
   double hfov_rad = 1.3125;  // 75.2 deg: fovy 60 deg at 4:3
   double vfov_rad = 1.0472;  // 60 deg
   double min_range_m = 0.3;
-  double max_range_m = 6.0;
+  // 10 m: the VO's depth range (vo.max_depth_m); the learned model's features are counted to it
+  double max_range_m = 10.0;
   // Where the camera sits on the vehicle, in the body frame: this far ahead along the heading and
   // above the body's centre. The planner's poses are the body's; a view is scored from the camera
   // (cameraPosition()). 0: from the body's centre, as the paper.

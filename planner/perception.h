@@ -52,9 +52,11 @@ struct InformationConfig {
   double min_detections = 50.0;
   // A learned perception model (track_model.h) in place of the three gates above: a pose scores
   // blind where the model gives the VO less than min_track_probability of tracking it. The file
-  // (JSON, scripts/fit_track_model.py) is read by the harness, which sets `model`; "none": the gates.
-  std::string track_model = "none";
-  double min_track_probability = 0.5;
+  // (JSON, scripts/fit_track_model.py) is read by the harness, which sets `model`; "none": the gates;
+  // "default": configs/track_model.json of the build's source tree ($TGNAV_CONFIGS_DIR's, when set).
+  // The planner library itself only reads `model`: a caller that sets none gets the gates.
+  std::string track_model = "default";
+  double min_track_probability = 0.35;      // the default model's (its threshold rule's choice)
   std::shared_ptr<const TrackModel> model;  // read from track_model; not a key
 
   // True when a pose's score needs the image cells its landmarks fall in: the coverage gate, or

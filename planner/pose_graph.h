@@ -67,7 +67,7 @@ struct PoseGraphConfig {
   // between, and a textured face can end within one step (15 deg): generated room-1002's start
   // turn passed, 5 deg past a lattice yaw, a view of a plain face with 5 detections inside the
   // detector's border, and the VO was lost there on every seed (docs/results/premise/ramps).
-  int turn_substeps = 1;
+  int turn_substeps = 4;
   double turn_floor = 6.0;  // c_p,thr: set by the planner from its selection config, not a file key
   // Views between the layers (ours; the paper scores the layers' poses only). The MAV flies from
   // one layer's pose to the next over Ts, its position and yaw moving in between, and the VO must

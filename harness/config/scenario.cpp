@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -157,23 +158,35 @@ void checkViewSettings(const planner::TrackModel& model, const planner::Percepti
 
 // Reads the learned perception model that planner.information.track_model names (relative to the
 // current directory when --set gives it, else to the scenario file) into the planners' settings,
-// and records its absolute path there (config.yaml); no model when the key is "none".
+// and records its absolute path there (config.yaml); no model when the key is "none"; "default"
+// (the default) is configs/track_model.json of the build's source tree, or $TGNAV_CONFIGS_DIR's.
 void readTrackModel(const YamlDoc& doc, const YamlDoc* overrides, PlannerSettings* planner) {
   planner::InformationConfig& info = planner->perception.information;
   info.model.reset();
-  if (info.track_model != "none") {
-    const bool overridden = overrides && overrides->root()["planner"] && overrides->root()["planner"]["information"] &&
-                            overrides->root()["planner"]["information"]["track_model"];
+  const bool overridden = overrides && overrides->root()["planner"] && overrides->root()["planner"]["information"] &&
+                          overrides->root()["planner"]["information"]["track_model"];
+  const std::string where = overridden ? std::string("--set") : doc.file().string();
+  if (info.track_model == "default") {
+    const char* env = std::getenv("TGNAV_CONFIGS_DIR");
+    const fs::path dir = env != nullptr && *env != '\0' ? fs::path(env) : fs::path(TGNAV_SOURCE_DIR "/configs");
+    const fs::path file = dir / "track_model.json";
+    if (!isRegularFile(file)) {
+      throw InputError(where + ": key 'planner.information.track_model' has value 'default': file " + file.string() +
+                       " not found (set TGNAV_CONFIGS_DIR, or track_model: none for the gates)");
+    }
+    info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
+    info.track_model = file.string();
+    checkViewSettings(*info.model, planner->perception, where);
+  } else if (info.track_model != "none") {
     const fs::path base = overridden ? fs::path() : doc.file().parent_path();
     const fs::path file = fs::absolute(base / info.track_model).lexically_normal();
     if (!isRegularFile(file)) {
-      throw InputError((overridden ? std::string("--set") : doc.file().string()) +
-                       ": key 'planner.information.track_model' has value '" + info.track_model + "': file " +
+      throw InputError(where + ": key 'planner.information.track_model' has value '" + info.track_model + "': file " +
                        file.string() + " not found");
     }
     info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
     info.track_model = file.string();
-    checkViewSettings(*info.model, planner->perception, overridden ? "--set" : doc.file().string());
+    checkViewSettings(*info.model, planner->perception, where);
   }
   planner->shareFromPerception();
 }

@@ -44,6 +44,41 @@ std::vector<double> numbers(const std::filesystem::path& file, const Json& doc, 
   return out;
 }
 
+// A term's entry of "ramps" (version 2): null, or [lo, hi] with lo < hi.
+void readRamp(const std::filesystem::path& file, const Json& r, std::size_t i, planner::TrackModel::Term* term) {
+  if (r.is_null()) return;
+  const std::string rkey = "ramps[" + std::to_string(i) + "]";
+  if (!r.is_array() || r.size() != 2) {
+    fail(file, "key '" + rkey + "' has value '" + r.dump().substr(0, 80) + "', expected null or [lo, hi]");
+  }
+  term->ramp = true;
+  term->ramp_lo = number(file, r[0], rkey + "[0]");
+  term->ramp_hi = number(file, r[1], rkey + "[1]");
+  if (!(term->ramp_hi > term->ramp_lo)) fail(file, "key '" + rkey + "' has value '" + r.dump() + "', expected lo < hi");
+}
+
+// The optional "view_settings" object: every key present and a finite number.
+void readViewSettings(const std::filesystem::path& file, const Json& doc, planner::TrackModel* model) {
+  const auto settings = doc.find("view_settings");
+  if (settings != doc.end()) {
+    if (!settings->is_object()) {
+      fail(file, "key 'view_settings' has value '" + settings->dump().substr(0, 80) + "', expected an object");
+    }
+    planner::TrackModel::ViewSettings& v = model->view_settings;
+    const std::pair<const char*, double*> keys[] = {{"hfov_rad", &v.hfov_rad},
+                                                    {"vfov_rad", &v.vfov_rad},
+                                                    {"min_range_m", &v.min_range_m},
+                                                    {"max_range_m", &v.max_range_m},
+                                                    {"max_incidence_rad", &v.max_incidence_rad}};
+    for (const auto& [key, value] : keys) {
+      const std::string name = std::string("view_settings.") + key;
+      if (!settings->contains(key)) fail(file, "key '" + name + "' is missing");
+      *value = number(file, (*settings)[key], name);
+    }
+    model->has_view_settings = true;
+  }
+}
+
 }  // namespace
 
 planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
@@ -99,40 +134,11 @@ planner::TrackModel loadTrackModel(const std::filesystem::path& file) {
     term.mean = mean[i];
     term.scale = scale[i];
     term.weight = weights[i];
-    if (ramps != doc.end() && !(*ramps)[i].is_null()) {
-      const Json& r = (*ramps)[i];
-      const std::string rkey = "ramps[" + std::to_string(i) + "]";
-      if (!r.is_array() || r.size() != 2) {
-        fail(file, "key '" + rkey + "' has value '" + r.dump().substr(0, 80) + "', expected null or [lo, hi]");
-      }
-      term.ramp = true;
-      term.ramp_lo = number(file, r[0], rkey + "[0]");
-      term.ramp_hi = number(file, r[1], rkey + "[1]");
-      if (!(term.ramp_hi > term.ramp_lo)) {
-        fail(file, "key '" + rkey + "' has value '" + r.dump() + "', expected lo < hi");
-      }
-    }
+    if (ramps != doc.end()) readRamp(file, (*ramps)[i], i, &term);
     model.terms.push_back(term);
   }
   model.intercept = number(file, member(file, doc, "intercept"), "intercept");
-  const auto settings = doc.find("view_settings");
-  if (settings != doc.end()) {
-    if (!settings->is_object()) {
-      fail(file, "key 'view_settings' has value '" + settings->dump().substr(0, 80) + "', expected an object");
-    }
-    planner::TrackModel::ViewSettings& v = model.view_settings;
-    const std::pair<const char*, double*> keys[] = {{"hfov_rad", &v.hfov_rad},
-                                                    {"vfov_rad", &v.vfov_rad},
-                                                    {"min_range_m", &v.min_range_m},
-                                                    {"max_range_m", &v.max_range_m},
-                                                    {"max_incidence_rad", &v.max_incidence_rad}};
-    for (const auto& [key, value] : keys) {
-      const std::string name = std::string("view_settings.") + key;
-      if (!settings->contains(key)) fail(file, "key '" + name + "' is missing");
-      *value = number(file, (*settings)[key], name);
-    }
-    model.has_view_settings = true;
-  }
+  readViewSettings(file, doc, &model);
   return model;
 }
 

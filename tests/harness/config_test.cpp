@@ -591,7 +591,9 @@ TEST_F(ConfigScenario, SectionsDefaultAndMessagesStay) {
   }
   const Scenario s = loadScenario(scenario(""));
   EXPECT_EQ(s.seed, 3u);
-  EXPECT_EQ(dump(toYaml(s.planner)), dump(toYaml(PlannerSettings{})));
+  PlannerSettings planner;  // the default model resolved to its file
+  planner.perception.information.track_model = (test::sourceDir() / "configs/track_model.json").string();
+  EXPECT_EQ(dump(toYaml(s.planner)), dump(toYaml(planner)));
   EXPECT_EQ(dump(toYaml(s.camera)), dump(toYaml(CameraConfig{})));
   EXPECT_EQ(dump(toYaml(s.controller)), dump(toYaml(control::CascadeConfig{})));
   EXPECT_EQ(dump(toYaml(s.vo)), dump(toYaml(vo::OdometryConfig{})));
@@ -901,8 +903,12 @@ TEST(ConfigDefaults, LoadBackAsTheScenariosSections) {
       dir / "plain.yaml", "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() + "\nseed: 3\n"));
   expectSameScenario(s, plain);
   EXPECT_EQ(resolvedScenarioYaml(s), resolvedScenarioYaml(plain));
-  // ... and the resolved config.yaml holds them, byte for byte.
-  const std::string body = text.substr(text.find("\nplanner:\n") + 1);
+  // ... and the resolved config.yaml holds them, byte for byte, the default model named by its file.
+  std::string body = text.substr(text.find("\nplanner:\n") + 1);
+  const std::string model_key = "track_model: default\n";
+  ASSERT_NE(body.find(model_key), std::string::npos);
+  body.replace(body.find(model_key), model_key.size(),
+               "track_model: " + (test::sourceDir() / "configs/track_model.json").string() + "\n");
   EXPECT_NE(resolvedScenarioYaml(s).find(body), std::string::npos);
 }
 

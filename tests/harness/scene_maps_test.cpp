@@ -13,9 +13,10 @@ namespace tgnav::harness {
 namespace {
 
 // Mean number of landmarks visible (range, vertical FoV, occlusion; any yaw) from points every
-// 0.25 m along the polyline at flight height.
+// 0.25 m along the polyline at flight height, to 6 m (the range the scene was designed with).
 double meanVisible(const planner::FeatureMap& map, const std::vector<Eigen::Vector2d>& polyline, double z) {
-  const planner::VisibilityConfig config;
+  planner::VisibilityConfig config;
+  config.max_range_m = 6.0;
   double sum = 0.0;
   int n = 0;
   for (std::size_t i = 0; i + 1 < polyline.size(); ++i) {

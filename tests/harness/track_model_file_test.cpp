@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 
@@ -132,7 +133,29 @@ TEST_F(TrackModelScenario, AScenarioNamesItsModelRelativeToItself) {
   ASSERT_NE(s.planner.perception.information.model, nullptr);
   EXPECT_EQ(s.planner.perception.information.track_model, (dir_ / "model.json").string());
   EXPECT_EQ(s.planner.rrt_star.information.model, s.planner.perception.information.model);  // one sensor model
-  EXPECT_EQ(loadScenario(scenario("")).planner.perception.information.model, nullptr);      // none: the gates
+  EXPECT_EQ(
+      loadScenario(scenario("planner: {information: {track_model: none}}\n")).planner.perception.information.model,
+      nullptr);  // none: the gates
+}
+
+// The default is configs/track_model.json of the source tree, or of $TGNAV_CONFIGS_DIR; a folder
+// without one is one line naming the key and the file.
+TEST_F(TrackModelScenario, TheDefaultModelIsTheShippedOne) {
+  const Scenario s = loadScenario(scenario(""));
+  ASSERT_NE(s.planner.perception.information.model, nullptr);
+  EXPECT_EQ(s.planner.perception.information.track_model, (test::sourceDir() / "configs/track_model.json").string());
+  EXPECT_EQ(s.planner.perception.information.model->source, s.planner.perception.information.track_model);
+  const planner::TrackModel shipped = loadTrackModel(test::sourceDir() / "configs/track_model.json");
+  ASSERT_EQ(s.planner.perception.information.model->terms.size(), shipped.terms.size());
+  EXPECT_EQ(s.planner.perception.information.model->intercept, shipped.intercept);
+
+  const auto file = scenario("");
+  ::setenv("TGNAV_CONFIGS_DIR", dir_.c_str(), 1);
+  const std::string msg = inputError([&] { loadScenario(file); });
+  ::unsetenv("TGNAV_CONFIGS_DIR");
+  EXPECT_EQ(msg, file.string() + ": key 'planner.information.track_model' has value 'default': file " +
+                     (dir_ / "track_model.json").string() +
+                     " not found (set TGNAV_CONFIGS_DIR, or track_model: none for the gates)");
 }
 
 TEST_F(TrackModelScenario, AMissingModelIsNamedWithItsKey) {

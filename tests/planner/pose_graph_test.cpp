@@ -545,6 +545,7 @@ TEST(PoseGraph, StartTurnSubstepsSeeABlindWindowBetweenLatticeYaws) {
   };
   PoseGraphConfig lattice;
   lattice.turn_floor = floor;
+  lattice.turn_substeps = 1;
   const PoseGraphResult a = searchPoseGraph(path, segments, voxels, vis, info, lattice, std::nan(""), 1, vehicle_yaw);
   PoseGraphConfig fine = lattice;
   fine.turn_substeps = 4;
