@@ -77,8 +77,8 @@ StartTurn sweepStartTurn(const Eigen::Vector3d& start, const std::vector<double>
   double right_miss = 0.0;
   for (int k = yaws - 1; 2 * k >= yaws; --k) {
     const auto ku = static_cast<std::size_t>(k);
-    for (int j = substeps * k; j < substeps * (k + 1); ++j) {
-      if (j > 0 && j < fine) right = std::min(right, view[static_cast<std::size_t>(j)]);
+    for (int j = substeps * k; j < substeps * (k + 1); ++j) {  // inside (0, fine): 2 k >= yaws, k < yaws
+      right = std::min(right, view[static_cast<std::size_t>(j)]);
     }
     right_miss += miss[ku];
     const bool fine_turn = right >= floor;

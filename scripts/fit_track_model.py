@@ -343,7 +343,7 @@ def cmd_fit(args):
         raise InputError(f"--features: '{unknown[0] if unknown else args.features}' is not one of {', '.join(FEATURES)}")
     terms = model_terms(names, parse_ramps(args.ramps, names))
     trials = select(read_sweeps(args.sweeps, args.min_z, args.views), names)
-    x, y = stack(trials, "x"), stack(trials, "y")
+    y = stack(trials, "y")
     if y.min() == y.max():
         raise InputError(f"{', '.join(args.sweeps)}: every frame has the same label; nothing to fit")
     settings = trials[0]["view_settings"]

@@ -166,23 +166,21 @@ void readTrackModel(const YamlDoc& doc, const YamlDoc* overrides, PlannerSetting
   const bool overridden = overrides && overrides->root()["planner"] && overrides->root()["planner"]["information"] &&
                           overrides->root()["planner"]["information"]["track_model"];
   const std::string where = overridden ? std::string("--set") : doc.file().string();
-  if (info.track_model == "default") {
-    const char* env = std::getenv("TGNAV_CONFIGS_DIR");
-    const fs::path dir = env != nullptr && *env != '\0' ? fs::path(env) : fs::path(TGNAV_SOURCE_DIR "/configs");
-    const fs::path file = dir / "track_model.json";
-    if (!isRegularFile(file)) {
-      throw InputError(where + ": key 'planner.information.track_model' has value 'default': file " + file.string() +
-                       " not found (set TGNAV_CONFIGS_DIR, or track_model: none for the gates)");
+  if (info.track_model != "none") {
+    fs::path file;
+    std::string hint;
+    if (info.track_model == "default") {
+      const char* env = std::getenv("TGNAV_CONFIGS_DIR");
+      file =
+          (env != nullptr && *env != '\0' ? fs::path(env) : fs::path(TGNAV_SOURCE_DIR "/configs")) / "track_model.json";
+      hint = " (set TGNAV_CONFIGS_DIR, or track_model: none for the gates)";
+    } else {
+      const fs::path base = overridden ? fs::path() : doc.file().parent_path();
+      file = fs::absolute(base / info.track_model).lexically_normal();
     }
-    info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
-    info.track_model = file.string();
-    checkViewSettings(*info.model, planner->perception, where);
-  } else if (info.track_model != "none") {
-    const fs::path base = overridden ? fs::path() : doc.file().parent_path();
-    const fs::path file = fs::absolute(base / info.track_model).lexically_normal();
     if (!isRegularFile(file)) {
       throw InputError(where + ": key 'planner.information.track_model' has value '" + info.track_model + "': file " +
-                       file.string() + " not found");
+                       file.string() + " not found" + hint);
     }
     info.model = std::make_shared<const planner::TrackModel>(loadTrackModel(file));
     info.track_model = file.string();
