@@ -57,3 +57,44 @@ TrajectorySetpoint SetpointTrajectory::sample(double t) const {
 }
 
 }  // namespace tgnav::control
+
+namespace tgnav::control {
+
+SetpointTrajectory spliceTrajectory(const SetpointTrajectory& current, const SetpointTrajectory& next, double t_switch,
+                                    double blend_s) {
+  std::vector<double> t;
+  std::vector<TrajectorySetpoint> sp;
+  for (std::size_t i = 0; i < current.times().size() && current.times()[i] < t_switch - 1e-9; ++i) {
+    t.push_back(current.times()[i]);
+    sp.push_back(current.setpoints()[i]);
+  }
+  const double shift = t_switch - next.startTime();
+  const double blend = std::min(std::max(blend_s, 0.0), next.endTime() - next.startTime());
+  for (std::size_t i = 0; i < next.times().size(); ++i) {
+    const double tt = next.times()[i] + shift;
+    TrajectorySetpoint b = next.setpoints()[i];
+    const double x = blend > 0.0 ? (tt - t_switch) / blend : 1.0;
+    if (x < 1.0) {
+      // Quintic smoothstep: s, s' and s'' are 0 at x = 0 and s = 1, s' = s'' = 0 at x = 1.
+      const double s = x * x * x * (10.0 + x * (-15.0 + 6.0 * x));
+      const double ds = 30.0 * x * x * (1.0 - x) * (1.0 - x) / blend;
+      const double dds = 60.0 * x * (1.0 - x) * (1.0 - 2.0 * x) / (blend * blend);
+      const TrajectorySetpoint a = current.sample(tt);
+      const Eigen::Vector3d dp = b.p_WB - a.p_WB;
+      const Eigen::Vector3d dv = b.v_WB - a.v_WB;
+      const double dyaw = std::remainder(b.yaw_rad - a.yaw_rad, 2.0 * M_PI);
+      TrajectorySetpoint m;
+      m.p_WB = a.p_WB + s * dp;
+      m.v_WB = a.v_WB + s * dv + ds * dp;
+      m.a_WB = a.a_WB + s * (b.a_WB - a.a_WB) + 2.0 * ds * dv + dds * dp;
+      m.yaw_rad = a.yaw_rad + s * dyaw;
+      m.yaw_rate_rad_s = a.yaw_rate_rad_s + s * (b.yaw_rate_rad_s - a.yaw_rate_rad_s) + ds * dyaw;
+      b = m;
+    }
+    t.push_back(tt);
+    sp.push_back(b);
+  }
+  return SetpointTrajectory(std::move(t), std::move(sp));
+}
+
+}  // namespace tgnav::control

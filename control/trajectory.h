@@ -25,4 +25,13 @@ class SetpointTrajectory {
   std::vector<TrajectorySetpoint> sp_;
 };
 
+// `next` (in its own time base) taking over from `current` at time `t_switch` of current's time
+// base: current's setpoints before t_switch, then next's shifted to start at t_switch, blended
+// from current's into next's over `blend_s` by a quintic smoothstep s(t), so that position,
+// velocity, acceleration, yaw and yaw rate stay continuous (the blend of p0 and p1 is
+// (1 - s) p0 + s p1, its derivatives by the product rule; yaw blends along the shorter turn).
+// With blend_s 0, next simply replaces current from t_switch.
+SetpointTrajectory spliceTrajectory(const SetpointTrajectory& current, const SetpointTrajectory& next, double t_switch,
+                                    double blend_s);
+
 }  // namespace tgnav::control

@@ -76,6 +76,10 @@ int hammingDistance(const std::array<std::uint8_t, 32>& a, const std::array<std:
 
 FeatureMap::FeatureMap(double resolution_m) : tree_(std::make_unique<octomap::OcTree>(resolution_m)) {}
 
+FeatureMap::FeatureMap(std::unique_ptr<octomap::OcTree> occupancy) : tree_(std::move(occupancy)) {
+  if (!tree_) throw std::invalid_argument("FeatureMap: no occupancy map");
+}
+
 bool FeatureMap::isOccupied(const Eigen::Vector3d& p_W) const {
   const octomap::OcTreeNode* node = tree_->search(toOcto(p_W));
   return node != nullptr && tree_->isNodeOccupied(node);

@@ -63,6 +63,8 @@ struct VisibilityConfig {
 class FeatureMap {
  public:
   explicit FeatureMap(double resolution_m);
+  // Takes an occupancy map as it is (no landmarks yet).
+  explicit FeatureMap(std::unique_ptr<octomap::OcTree> occupancy);
 
   octomap::OcTree& occupancy() { return *tree_; }
   const octomap::OcTree& occupancy() const { return *tree_; }

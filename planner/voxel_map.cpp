@@ -18,13 +18,13 @@ constexpr double kClearLead = 1.0 - 1e-6;
 }  // namespace
 
 VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W,
-                   double clearance_z_lo_m, double clearance_z_hi_m)
+                   double clearance_z_lo_m, double clearance_z_hi_m, bool unknown_free)
     : res_(map.resolution()) {
   const Eigen::Vector3d lo = (min_W / res_).array().floor();
   const Eigen::Vector3d hi = (max_W / res_).array().ceil();
   origin_ = lo * res_;
   size_ = (hi - lo).cast<int>().cwiseMax(1);
-  state_.assign(static_cast<std::size_t>(size_.prod()), VoxelState::kUnknown);
+  state_.assign(static_cast<std::size_t>(size_.prod()), unknown_free ? VoxelState::kFree : VoxelState::kUnknown);
 
   const octomap::OcTree& tree = map.occupancy();
   const octomap::point3d bmin(static_cast<float>(origin_.x()), static_cast<float>(origin_.y()),

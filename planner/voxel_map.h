@@ -38,8 +38,10 @@ class VoxelMap {
   // [clearance_z_lo_m, clearance_z_hi_m] (everything above or below counts as blocked): the
   // distance field then covers only that band plus kClearanceReach_m, which is exact for every
   // clearance up to kClearanceReach_m (planners only ask whether clearance >= robot radius).
+  // With `unknown_free`, voxels never observed count as free (an online planner's optimism about
+  // space it has not seen yet); by default they block like occupied ones.
   VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Eigen::Vector3d& max_W,
-           double clearance_z_lo_m = -1e9, double clearance_z_hi_m = 1e9);
+           double clearance_z_lo_m = -1e9, double clearance_z_hi_m = 1e9, bool unknown_free = false);
   static constexpr double kClearanceReach_m = 1.0;
 
   double resolution() const { return res_; }

@@ -24,21 +24,32 @@ Map layer (optional in trial and plan folders, required in map folders):
                        raster's colours (0-255), drawn as legend entries}
   Both files or neither: without them a figure has no background.
 
-trial  (a `tgnav trial` folder) -> topdown, ate
+trial  (a `tgnav trial` folder) -> topdown, ate, and online_plans with online.json
   gt.tum           required; the true camera path (TUM: t tx ty tz qx qy qz qw, '#' comments)
   vo.csv           required; one row per frame with columns x_true,y_true,z_true and
                    x_est,y_est,z_est (world frame: the VO starts at the true pose; empty when
                    the frame was not tracked), other columns ignored
   est.tum          optional, may be empty; the VO's camera path (tracked frames)
   trajectory.csv   optional; the flown trajectory, columns x and y used
-  plan.json        optional; `path` ([[x, y, ...], ...], may be empty) is the planned path, and
-                   `start`/`goal` ([x, y, ...]) the start and goal (else the map layer's)
+  plan.json        optional; `path` ([[x, y, ...], ...], may be empty) is the planned path (of an
+                   online trial: the first plan), and `start`/`goal` ([x, y, ...]) the start and
+                   goal (else the map layer's)
+  online.json      optional (`tgnav trial --online`); `plans`, each (re)plan in time order:
+                   {"t_s" (sim time, gt.tum's clock), "trigger" (text), "ok", "adopted" (true when
+                   it was flown), "start" ([x, y, ...]), "path" ([[x, y, z, unknown01], ...], may be
+                   empty; unknown01 1 where the point lay in space never observed), ...}
   metrics.json     optional (an interrupted trial has none); `scene`, `planner`, `seed`,
                    `status` make the titles, `vo_lost_position` ([x, y, z] or null) with
                    `vo_lost_at_s` and `collision` ({"t_s", "position", ...} or null) the
                    VO-lost and collision markers
   topdown: map, planned path, trajectory, flown (true) and VO-estimated paths, start, goal,
-  VO-lost and collision markers, legend, title "<scene> <planner> seed <seed>: <status>".
+  VO-lost and collision markers, legend, title "<scene> <planner> seed <seed>: <status>"; with
+  online.json also every adopted plan as a thin line coloured by its time (colour bar), and
+  plan.json's path is the "first plan".
+  online_plans (only with online.json): one small top-down panel per adopted plan (at most 12,
+  evenly chosen, the first and the last always), titled "t = <t_s> s (<trigger>)": the map, the
+  plan (dashed in another colour where it runs through unknown space), its start, the goal and
+  the flown (true) path up to t_s.
   ate: VO position error |p_est - p_true| (no alignment: the VO frame is the true frame at
   take-off) against distance travelled along the true path, its RMSE in the legend, a marker
   at the last tracked frame before the VO was first lost (the paper's Fig. 4).
@@ -122,8 +133,10 @@ try:
     import matplotlib
     from matplotlib import colormaps, colors, image, patheffects
     from matplotlib.cm import ScalarMappable
+    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
     from matplotlib.ticker import MaxNLocator
 except ImportError as error:
     MISSING = error
@@ -166,6 +179,11 @@ COLLISION_STYLE = {"ls": "", "marker": "X", "ms": 11, "mfc": COLLISION, "mec": "
 # c_p of a class: red (weakest segment far below c_p,thr) to green (far above).
 QUALITY_CMAP = "RdYlGn"
 MAP_WIDTH_IN = 7.2  # topdown figures; the legend takes about a third
+UNKNOWN_PATH = "#e67300"  # a plan's stretch through space never observed
+PLAN_TIME_CMAP = "viridis"  # online plans coloured by their time
+ONLINE_PANELS = 12  # the most plans online_plans shows
+ONLINE_COLUMNS = 4
+ONLINE_PANEL_IN = 2.9
 
 
 class DataError(Exception):
@@ -445,10 +463,9 @@ def draw_start_goal(ax, start, goal):
         ax.plot(*goal, **GOAL_STYLE, label="goal", zorder=8)
 
 
-def set_topdown_limits(ax, extent, paths, margin=0.5):
-    """Equal-aspect limits over the map's extent (or None) and every finite point of `paths`
-    (n x 2 arrays), with `margin` around the points outside the map; then the figure's height
-    to fit."""
+def topdown_bounds(extent, paths, margin=0.5):
+    """x_min, x_max, y_min, y_max over the map's extent (or None) and every finite point of
+    `paths` (n x 2 arrays), with `margin` around the points outside the map."""
     points = np.concatenate([np.empty((0, 2))] + [p for p in paths if len(p)])
     points = points[np.isfinite(points).all(axis=1)]
     if extent is None and not len(points):
@@ -458,6 +475,14 @@ def set_topdown_limits(ax, extent, paths, margin=0.5):
         (lo_x, lo_y), (hi_x, hi_y) = points.min(axis=0), points.max(axis=0)
         x0, y0 = (lo_x - margin if lo_x < x0 else x0), (lo_y - margin if lo_y < y0 else y0)
         x1, y1 = (hi_x + margin if hi_x > x1 else x1), (hi_y + margin if hi_y > y1 else y1)
+    return x0, x1, y0, y1
+
+
+def set_topdown_limits(ax, extent, paths, margin=0.5):
+    """Equal-aspect limits over the map's extent (or None) and every finite point of `paths`
+    (n x 2 arrays), with `margin` around the points outside the map; then the figure's height
+    to fit."""
+    x0, x1, y0, y1 = topdown_bounds(extent, paths, margin)
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
@@ -498,18 +523,32 @@ def new_figure(**kwargs):
 
 
 @dataclass
+class OnlinePlan:
+    """One (re)plan of online.json."""
+    t: float  # sim time, as gt.tum's
+    trigger: str
+    ok: bool
+    adopted: bool  # flown
+    start: tuple  # (x, y)
+    path: "np.ndarray"  # n x 2
+    unknown: "np.ndarray"  # n bools: the point lay in space never observed when planned
+
+
+@dataclass
 class Trial:
     name: str  # what the title calls it without metrics.json
     metrics: "Json"  # or None
     planned: "np.ndarray"  # n x 2
     trajectory: "np.ndarray"
     flown: "np.ndarray"
+    flown_t: "np.ndarray"  # the time of each row of flown
     estimated: "np.ndarray"
     start: tuple
     goal: tuple
     distance: "np.ndarray"  # per frame of vo.csv
     error: "np.ndarray"
     layer: MapLayer
+    online: list  # the OnlinePlans of online.json, or None without one
 
 
 def plan_start_goal(plan, layer):
@@ -522,10 +561,25 @@ def plan_start_goal(plan, layer):
     return start, goal
 
 
+def load_online(path):
+    """The plans of an optional online.json, or None without one."""
+    doc = read_json_optional(path)
+    if doc is None:
+        return None
+    plans = []
+    for plan in doc["plans"].items():
+        rows = plan["path"].rows(4)
+        plans.append(OnlinePlan(t=plan["t_s"].number(), trigger=plan["trigger"].text(), ok=plan["ok"].flag(),
+                                adopted=plan["adopted"].flag(), start=plan["start"].xy(), path=xy_of(rows),
+                                unknown=rows[:, 3] > 0.5))
+    return plans
+
+
 def load_trial(folder):
     path = functools.partial(os.path.join, folder)
     plan = read_json_optional(path("plan.json"))
     layer = load_map_layer(folder)
+    gt = read_tum(path("gt.tum"))
     est = read_tum(path("est.tum")) if os.path.exists(path("est.tum")) else np.empty((0, 8))
     distance, error = vo_error(read_vo_csv(path("vo.csv")))
     start, goal = plan_start_goal(plan, layer)
@@ -534,13 +588,15 @@ def load_trial(folder):
         metrics=read_json_optional(path("metrics.json")),
         planned=xy_of(plan["path"].rows(2)) if plan is not None and plan.get("path") else np.empty((0, 2)),
         trajectory=read_trajectory_xy(path("trajectory.csv")),
-        flown=xy_of(read_tum(path("gt.tum")), 1, 2),
+        flown=xy_of(gt, 1, 2),
+        flown_t=gt[:, 0],
         estimated=xy_of(est, 1, 2),
         start=start,
         goal=goal,
         distance=distance,
         error=error,
         layer=layer,
+        online=load_online(path("online.json")),
     )
 
 
@@ -566,14 +622,40 @@ def trial_events(trial):
     return events
 
 
+def plan_time_colours(plans):
+    """Colour map and norm of the plans' times: viridis without its palest yellow."""
+    times = [p.t for p in plans] or [0.0]
+    lo, hi = min(times), max(times)
+    cmap = colors.ListedColormap(colormaps[PLAN_TIME_CMAP](np.linspace(0.0, 0.88, 256)))
+    return cmap, colors.Normalize(lo - 0.5, hi + 0.5) if lo == hi else colors.Normalize(lo, hi)
+
+
+def draw_online_plans(fig, ax, plans):
+    """Every adopted plan's path as a thin line coloured by its time, with a colour bar; returns
+    the paths."""
+    adopted = [p for p in plans if p.adopted and len(p.path)]
+    cmap, norm = plan_time_colours(adopted)
+    lines = LineCollection([p.path for p in adopted], cmap=cmap, norm=norm, linewidths=1.0, alpha=0.9, zorder=2)
+    lines.set_array(np.array([p.t for p in adopted]))
+    ax.add_collection(lines)
+    ax.plot([], [], color=cmap(0.5), lw=1.0, label="plans (colour: time)")  # the legend's entry
+    bar = fig.colorbar(ScalarMappable(norm, cmap), ax=ax, location="bottom", shrink=0.45, aspect=30, pad=0.02)
+    bar.set_label("time of the (adopted) plan [s]")
+    bar.ax.xaxis.set_major_locator(MaxNLocator(nbins=6))
+    return [p.path for p in adopted]
+
+
 @styled
 def trial_topdown_figure(trial):
     fig = new_figure()
     ax = fig.add_subplot()
     if trial.layer is not None:
         draw_map(ax, trial.layer)
+    online = trial.online is not None
+    plans = draw_online_plans(fig, ax, trial.online) if online else []
     # The trajectory goes over the flown path, so the reference shows as dashes where they coincide.
-    draw_path(ax, trial.planned, PLANNED, 1.2, "planned path", zorder=2)
+    draw_path(ax, trial.planned, PLANNED, 1.2, "first plan" if online else "planned path",
+              dashes=(4, 2) if online else None, zorder=2.5)
     draw_path(ax, trial.flown, FLOWN, 3.6, "flown (true)", outline=True, zorder=3)
     draw_path(ax, trial.trajectory, TRAJECTORY, 1.0, "trajectory", dashes=(5, 3), zorder=4)
     draw_path(ax, trial.estimated, ESTIMATED, 1.3, "VO estimate", outline=True, zorder=5)
@@ -582,10 +664,12 @@ def trial_topdown_figure(trial):
     for xy, style, label in events:
         ax.plot(*xy, **style, label=label, zorder=9)
     map_legend(ax, trial.layer)
-    points = [trial.planned, trial.flown, trial.trajectory, trial.estimated]
+    points = [trial.planned, trial.flown, trial.trajectory, trial.estimated] + plans
     points += [np.array([xy]) for xy in (trial.start, trial.goal) if xy is not None]
     points += [np.array([xy]) for xy, _, _ in events]
     set_topdown_limits(ax, trial.layer.extent if trial.layer is not None else None, points)
+    if online:  # room for the colour bar
+        fig.set_size_inches(fig.get_figwidth(), fig.get_figheight() + 0.7)
     ax.set_title(trial_title(trial))
     legend_outside(ax)
     return fig
@@ -619,10 +703,105 @@ def trial_ate_figure(trial):
     return fig
 
 
+def pick_evenly(items, most):
+    """At most `most` of `items`, evenly spread, the first and the last always."""
+    if len(items) <= most:
+        return list(items)
+    return [items[k] for k in sorted({round(i * (len(items) - 1) / (most - 1)) for i in range(most)})]
+
+
+def segments_where(xy, mask):
+    """The segments k -> k + 1 of a path (n x 2) where mask[k], as one array with NaN gaps."""
+    parts = [[xy[k], xy[k + 1], [math.nan, math.nan]] for k in np.flatnonzero(mask)]
+    return np.array(parts, dtype=float).reshape(-1, 2)
+
+
+def draw_online_panel(ax, trial, plan, limits):
+    if trial.layer is not None:
+        draw_map(ax, trial.layer, interpolation="bilinear", alpha=0.85)
+    through = plan.unknown[:-1] | plan.unknown[1:]  # a segment with an end in unknown space
+    draw_path(ax, segments_where(plan.path, ~through), PLANNED, 1.4, None, zorder=3)
+    draw_path(ax, segments_where(plan.path, through), UNKNOWN_PATH, 1.4, None, dashes=(3, 1.5), zorder=3)
+    draw_path(ax, trial.flown[trial.flown_t <= plan.t], FLOWN, 2.2, None, outline=True, zorder=4)
+    ax.plot(*plan.start, **dict(START_STYLE, ms=6, mew=1.2), zorder=8)
+    if trial.goal is not None:
+        ax.plot(*trial.goal, **dict(GOAL_STYLE, ms=10), zorder=8)
+    ax.set_xlim(*limits[:2])
+    ax.set_ylim(*limits[2:])
+    ax.set_aspect("equal")
+    ax.set_title(f"t = {plan.t:.2f} s ({plan.trigger})", fontsize=9)
+    ax.tick_params(labelsize=7)
+
+
+def online_plans_legend(fig, trial):
+    legend = [Line2D([], [], color=PLANNED, lw=1.4, label="plan"),
+              Line2D([], [], color=UNKNOWN_PATH, lw=1.4, dashes=(3, 1.5), label="through unknown"),
+              Line2D([], [], color=FLOWN, lw=2.2, label="flown (true) so far"),
+              Line2D([], [], **dict(START_STYLE, ms=6, mew=1.2), label="plan start")]
+    if trial.goal is not None:
+        legend.append(Line2D([], [], **dict(GOAL_STYLE, ms=10), label="goal"))
+    legend += [Patch(color=rgb, ec="#808080", lw=0.5, label=label) for label, rgb in
+               (trial.layer.legend if trial.layer is not None else [])]
+    fig.legend(handles=legend, loc="lower center", ncol=min(len(legend), 5), frameon=False,
+               bbox_to_anchor=(0.5, 0.02 / fig.get_figheight()))
+
+
+def online_axes(panels, limits):
+    """A figure of `panels` equal-aspect panels of the same `limits`, ONLINE_COLUMNS a row, with
+    room for the title above and the legend below (margins set in inches: constrained layout
+    leaves no room for a figure legend)."""
+    columns = max(1, min(panels, ONLINE_COLUMNS))
+    rows = max(1, math.ceil(panels / columns))
+    axes_w = ONLINE_PANEL_IN
+    axes_h = axes_w * min(max((limits[3] - limits[2]) / (limits[1] - limits[0]), 0.3), 2.5)
+    gap_w, gap_h = 0.15, 0.4  # between panels: no inner tick labels, a title above each
+    panels_w = columns * axes_w + (columns - 1) * gap_w
+    width = max(panels_w + 0.8, 6.5)  # the legend's width at least
+    height = rows * axes_h + (rows - 1) * gap_h + 0.8 + 1.1  # the title's lines, x labels and the legend
+    left = max(0.6, (width - panels_w) / 2)
+    fig = Figure(figsize=(width, height))
+    axes = fig.subplots(rows, columns, squeeze=False, sharex=True, sharey=True, gridspec_kw={
+        "left": left / width, "right": (left + panels_w) / width, "top": 1 - 0.8 / height, "bottom": 1.1 / height,
+        "wspace": gap_w / axes_w, "hspace": gap_h / axes_h})
+    return fig, axes
+
+
+@styled
+def online_plans_figure(trial):
+    """One small top-down panel per adopted plan (at most ONLINE_PANELS, evenly chosen)."""
+    adopted = [p for p in trial.online if p.adopted]
+    shown = pick_evenly(adopted, ONLINE_PANELS)
+    extent = trial.layer.extent if trial.layer is not None else None
+    limits = topdown_bounds(extent, [trial.flown] + [p.path for p in shown], margin=0.3)
+    fig, axes = online_axes(len(shown), limits)
+    for ax, plan in zip(axes.flat, shown):
+        draw_online_panel(ax, trial, plan, limits)
+    for ax in list(axes.flat)[len(shown):]:
+        ax.axis("off")
+    if not shown:
+        axes[0, 0].text(0.5, 0.5, "no plan was adopted", ha="center", va="center", transform=axes[0, 0].transAxes)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("y [m]")
+    for ax in axes[-1]:
+        ax.set_xlabel("x [m]")
+    online_plans_legend(fig, trial)
+    failed = sum(not p.ok for p in trial.online)
+    shown_note = f" ({len(shown)} shown)" if len(shown) < len(adopted) else ""
+    background = ", over the final map" if trial.layer is not None else ""
+    fig.suptitle(f"{trial_title(trial)}\n{len(adopted)} of {len(trial.online)} online plans adopted{shown_note}, "
+                 f"{failed} without a route{background}",
+                 y=1 - 0.1 / fig.get_figheight(), va="top")
+    return fig
+
+
 def trial_figures(folder):
-    """{"topdown": Figure, "ate": Figure} of a `tgnav trial` folder."""
+    """{"topdown": Figure, "ate": Figure, and "online_plans": Figure with online.json} of a `tgnav
+    trial` folder."""
     trial = load_trial(folder)
-    return {"topdown": trial_topdown_figure(trial), "ate": trial_ate_figure(trial)}
+    figures = {"topdown": trial_topdown_figure(trial), "ate": trial_ate_figure(trial)}
+    if trial.online is not None:
+        figures["online_plans"] = online_plans_figure(trial)
+    return figures
 
 
 # ---------------------------------------------------------------------------------------------
@@ -1407,7 +1586,8 @@ def save_figures(figures, out_dir, fmt="png"):
 
 
 def plot_trial(folder, out=None, fmt="png"):
-    """topdown.<fmt> and ate.<fmt> of a `tgnav trial` folder into `out` (default the folder)."""
+    """topdown.<fmt>, ate.<fmt> (and online_plans.<fmt> with online.json) of a `tgnav trial` folder
+    into `out` (default the folder)."""
     return save_figures(trial_figures(folder), out or folder, fmt)
 
 

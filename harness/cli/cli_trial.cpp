@@ -112,6 +112,10 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_option("--threads", job.threads,
                   "Use at most N threads (planner, OpenCV, renderer; 1 also renders and tracks in turn); "
                   "results do not change. Default: as configured");
+  auto online = std::make_shared<bool>(false);
+  cmd->add_flag("--online", *online,
+                "Plan online: start without a map, map the onboard frames at the VO's pose and replan "
+                "(= --set trial.mode=online --set trial.state_source=vo, before the other --set)");
   cmd->add_flag("--force", job.force, "Replace the results already in --out");
   cmd->add_option("--frames", job.frames, "Also write frames.png: a strip of N onboard frames (0-64)");
   cmd->add_option("--map", job.map, "Feature map folder from `tgnav map` (default: cached by content)");
@@ -129,8 +133,9 @@ void addTrialCommand(CLI::App& app) {
                   "agnostic: its shortest path); not with rrtstar");
   cmd->add_option("--figure-format", opt->figure_format, "png | pdf | svg")->capture_default_str();
   cmd->add_flag("--no-figures", opt->no_figures, "Write the data only (a sweep's report draws the figures)");
-  cmd->callback([opt, cmd, homology_class] {
+  cmd->callback([opt, cmd, homology_class, online] {
     if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
+    if (*online) opt->job.set.insert(opt->job.set.begin(), {"trial.mode=online", "trial.state_source=vo"});
     for (const char* given : {"--trajectory", "--path"}) {
       if (cmd->count(given) > 0 && cmd->count("--planner") > 0) {
         throw InputError(std::string(given) + ": flies what it is given; --planner is for planning one");

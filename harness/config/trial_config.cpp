@@ -31,6 +31,30 @@ bool parseStateSource(const std::string& text, StateSource* source) {
   return false;
 }
 
+const std::vector<std::pair<std::string, TrialMode>>& trialModeNames() {
+  static const std::vector<std::pair<std::string, TrialMode>> names = {{"prior", TrialMode::kPrior},
+                                                                       {"online", TrialMode::kOnline}};
+  return names;
+}
+
+const std::vector<std::pair<std::string, PriorMap>>& priorMapNames() {
+  static const std::vector<std::pair<std::string, PriorMap>> names = {
+      {"none", PriorMap::kNone}, {"survey", PriorMap::kSurvey}, {"radius", PriorMap::kRadius}};
+  return names;
+}
+
+const std::vector<std::pair<std::string, MapPose>>& mapPoseNames() {
+  static const std::vector<std::pair<std::string, MapPose>> names = {{"estimate", MapPose::kEstimate},
+                                                                     {"truth", MapPose::kTruth}};
+  return names;
+}
+
+const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames() {
+  static const std::vector<std::pair<std::string, UnknownSpace>> names = {{"free", UnknownSpace::kFree},
+                                                                          {"blocked", UnknownSpace::kBlocked}};
+  return names;
+}
+
 namespace {
 
 void nonNegative(double value, const char* field) {
@@ -55,6 +79,22 @@ void ImuConfig::validate() const {
   nonNegative(gyro_bias_rad_s, "gyro_bias_rad_s");
 }
 
+void OnlineConfig::validate() const {
+  require(std::isfinite(prior_radius_m) && prior_radius_m > 0.0, "prior_radius_m", prior_radius_m, "must be > 0");
+  require(std::isfinite(plan_latency_s) && plan_latency_s >= 0.0 && plan_latency_s <= 10.0, "plan_latency_s",
+          plan_latency_s, "must be in [0, 10]");
+  require(std::isfinite(replan_period_s) && replan_period_s > plan_latency_s && replan_period_s <= 60.0,
+          "replan_period_s", replan_period_s, "must be > plan_latency_s and <= 60");
+  require(std::isfinite(blend_s) && blend_s >= 0.0 && blend_s <= 10.0, "blend_s", blend_s, "must be in [0, 10]");
+  require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
+          "must be in [0, 10]");
+  require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
+          "must be in [1, 100]");
+  require(map_stride_px >= 1 && map_stride_px <= 64, "map_stride_px", map_stride_px, "must be in [1, 64]");
+  require(std::isfinite(max_flight_s) && max_flight_s > 0.0 && max_flight_s <= 3600.0, "max_flight_s", max_flight_s,
+          "must be in (0, 3600]");
+}
+
 void TrialConfig::validate() const {
   require(std::isfinite(camera_rate_hz) && camera_rate_hz > 0.0, "camera_rate_hz", camera_rate_hz, "must be > 0");
   require(std::isfinite(goal_radius_m) && goal_radius_m > 0.0, "goal_radius_m", goal_radius_m, "must be > 0");
@@ -62,6 +102,16 @@ void TrialConfig::validate() const {
   validateMember(flight, "flight");
   validateMember(imu, "imu");
   validateMember(estimator, "estimator");
+  online.validate();
+  if (online.online()) {
+    const StateSource flies_on = online.map_pose == MapPose::kTruth ? StateSource::kGroundTruth : StateSource::kVo;
+    if (state_source != flies_on) {
+      throw std::invalid_argument(std::string("state_source = ") + toString(state_source) + ": must be " +
+                                  toString(flies_on) + " in online mode with map_pose " +
+                                  (online.map_pose == MapPose::kTruth ? "truth" : "estimate") +
+                                  " (an online trial flies on the pose it maps at)");
+    }
+  }
 }
 
 }  // namespace tgnav::harness

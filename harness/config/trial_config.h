@@ -37,6 +37,67 @@ struct ImuConfig {
   void validate() const;  // std::invalid_argument naming the field and value
 };
 
+// How a trial plans (trial.mode): `prior` plans once on the scene's survey map before take-off;
+// `online` starts with the map of `prior_map`, builds the occupancy and the landmarks from the
+// onboard RGB-D frames during flight, at the pose of `map_pose`, and replans on it
+// (harness/run/online_planning.h).
+enum class TrialMode { kPrior, kOnline };
+const std::vector<std::pair<std::string, TrialMode>>& trialModeNames();  // "prior", "online"
+// What an online trial knows before take-off: nothing, the survey map, or the survey map within
+// prior_radius_m of the start.
+enum class PriorMap { kNone, kSurvey, kRadius };
+const std::vector<std::pair<std::string, PriorMap>>& priorMapNames();  // "none", "survey", "radius"
+// The pose an online trial maps at: its own estimate (the VO fused with the IMU; it flies on it),
+// or the truth (the ablation that isolates the VO's drift; it flies on ground truth).
+enum class MapPose { kEstimate, kTruth };
+const std::vector<std::pair<std::string, MapPose>>& mapPoseNames();  // "estimate", "truth"
+// Space never observed, for the planners of an online trial: free (planned through, optimistic)
+// or blocked (avoided).
+enum class UnknownSpace { kFree, kBlocked };
+const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames();  // "free", "blocked"
+
+// The keys of an online trial (flat in `trial:`); unused in prior mode.
+struct OnlineConfig {
+  TrialMode mode = TrialMode::kPrior;
+  PriorMap prior_map = PriorMap::kNone;
+  double prior_radius_m = 2.0;  // prior_map radius
+  MapPose map_pose = MapPose::kEstimate;
+  UnknownSpace unknown_space = UnknownSpace::kFree;
+  // A plan takes effect this long (simulated time) after the state it starts from was sampled:
+  // the vehicle flies its current trajectory meanwhile. Configured, never measured.
+  double plan_latency_s = 0.5;
+  double replan_period_s = 2.0;  // a plan every this much simulated time, and on events
+  double blend_s = 1.0;          // the new trajectory replaces the old one over this long
+  // Where the trajectory this far ahead runs through space unknown when planned (or everywhere,
+  // with look_ahead_always), the camera turns from the planner's yaw as little as keeps the way
+  // there in view (look before flying there); 0: the planner's yaw everywhere.
+  double look_ahead_s = 2.0;
+  bool look_ahead_always = false;
+  int map_every_frames = 4;     // every Nth camera frame goes into the map (a keyframe)
+  int map_stride_px = 8;        // ... every Nth pixel of its depth, in both directions
+  double max_flight_s = 120.0;  // simulated time from take-off; beyond it the flight stops
+
+  template <typename Archive>
+  void visit(Archive& a) {
+    a.choice("mode", mode, trialModeNames());
+    a.choice("prior_map", prior_map, priorMapNames());
+    a("prior_radius_m", prior_radius_m);
+    a.choice("map_pose", map_pose, mapPoseNames());
+    a.choice("unknown_space", unknown_space, unknownSpaceNames());
+    a("plan_latency_s", plan_latency_s);
+    a("replan_period_s", replan_period_s);
+    a("blend_s", blend_s);
+    a("look_ahead_s", look_ahead_s);
+    a("look_ahead_always", look_ahead_always);
+    a("map_every_frames", map_every_frames);
+    a("map_stride_px", map_stride_px);
+    a("max_flight_s", max_flight_s);
+  }
+
+  bool online() const { return mode == TrialMode::kOnline; }
+  void validate() const;
+};
+
 struct TrialConfig {
   StateSource state_source = StateSource::kGroundTruth;
   double camera_rate_hz = 20.0;
@@ -48,6 +109,7 @@ struct TrialConfig {
   FlightConfig flight;
   ImuConfig imu;
   control::EstimatorConfig estimator;
+  OnlineConfig online;  // its keys are flat in `trial:` (trial.mode, trial.plan_latency_s, ...)
 
   // The keys of configs/trial.yaml (harness/config/yaml_util.h).
   template <typename Archive>
@@ -60,6 +122,7 @@ struct TrialConfig {
     a("flight", flight);
     a("imu", imu);
     a("estimator", estimator);
+    online.visit(a);
   }
 
   void validate() const;  // std::invalid_argument naming the field (dotted within trial) and value

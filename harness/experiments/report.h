@@ -22,8 +22,8 @@ namespace tgnav::harness {
 
 // Trial outcomes as metrics.json and index.csv spell them.
 inline const std::vector<std::string>& trialStatusNames() {
-  static const std::vector<std::string> names = {"success",  "drifted", "vo_lost",    "collision",
-                                                 "diverged", "timeout", "plan_failed"};
+  static const std::vector<std::string> names = {"success",  "drifted", "vo_lost",     "collision",
+                                                 "diverged", "timeout", "plan_failed", "no_path"};
   return names;
 }
 

@@ -89,22 +89,22 @@ ClearanceBand clearanceBand(const Scenario& scenario) {
   return {z - reach - 0.2, z + reach + 0.2};
 }
 
-void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run) {
+void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run, bool unknown_free) {
   const auto t0 = std::chrono::steady_clock::now();
   const SceneConfig& scene = scenario.scene;
   const ClearanceBand band = clearanceBand(scenario);
   run->voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
                                                     scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                    band.lo_m, band.hi_m);
+                                                    band.lo_m, band.hi_m, unknown_free);
   run->voxel_map_s = secondsSince(t0);
 }
 
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
-                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option) {
+                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option, bool unknown_free) {
   PlanRun run;
   run.planner = kind;
   run.seed = seed;
-  buildPlanningVoxels(scenario, map, &run);
+  buildPlanningVoxels(scenario, map, &run, unknown_free);
 
   planner::RrtStarConfig rrt = scenario.planner.rrt_star;
   if (kind == planner::PlannerKind::kRrtStar) {

@@ -44,7 +44,9 @@ ClearanceBand clearanceBand(const Scenario& scenario);
 // The planners' dense voxel map of `map` into run->voxels (its time into voxel_map_s): the scene's
 // bounds widened by 0.5 m (walls lie just outside the free-space bounds and must be inside the box
 // to be seen and avoided), with the distance field over clearanceBand().
-void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run);
+// With `unknown_free`, space never observed counts as free (online planning, trial.unknown_space).
+void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& map, PlanRun* run,
+                         bool unknown_free = false);
 // `path` as a trajectory from the scene's start pose (the vehicle may turn on the spot first), kept
 // at the configured clearance, into run->trajectory (its time into trajectory_s); with
 // `obstacle_points`, also in the path's homology class. Needs run->voxels.
@@ -57,8 +59,10 @@ void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario);
 
 // An oracle class (scenario.planner.oracle_class) with RRT*, or beyond the classes found, is an
 // InputError naming `oracle_option`.
+// `unknown_free` as for buildPlanningVoxels.
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind name,
-                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class");
+                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class",
+                   bool unknown_free = false);
 
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
 // A run's config.yaml: "# tgnav COMMAND --planner P [--samples N] --seed S [--class K]", then the

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <memory>
 #include <opencv2/core/utility.hpp>
 #include <set>
@@ -12,13 +13,15 @@
 #include "control/state_estimator.h"
 #include "harness/base/errors.h"
 #include "harness/base/process.h"
-#include "harness/run/given_route.h"
+#include "harness/run/online_planning.h"
 #include "harness/run/trial_metrics.h"
+#include "harness/run/trial_route.h"
 #include "harness/run/vo_pipeline.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/imu_sim.h"
 #include "harness/sim/mujoco_sim.h"
+#include "harness/sim/scene_geometry.h"
 #include "harness/sim/vehicle_model.h"
 #include "vo/stage_clock.h"
 
@@ -85,8 +88,9 @@ class ClosedLoop {
   using Clock = std::chrono::steady_clock;
 
  public:
+  // `online`: the online planner that maps the keyframes and replans (none: fly `trajectory`).
   ClosedLoop(const Scenario& scenario, const TrialOptions& options, const control::SetpointTrajectory& trajectory,
-             TrialResult* result)
+             TrialResult* result, OnlinePlanning* online)
       : scenario_(scenario),
         cfg_(scenario.trial),
         trajectory_(trajectory),
@@ -107,7 +111,9 @@ class ClosedLoop {
         strip_(stripFrames(options.strip_frames, timeline_.end_s, cfg_.camera_rate_hz)),
         fly_on_vo_(cfg_.state_source == StateSource::kVo),
         reinitialise_(scenario.vo.reinitialise_after_lost),
-        vehicle_root_(model_->body_rootid[ids_.body]) {
+        vehicle_root_(model_->body_rootid[ids_.body]),
+        online_(online) {
+    if (online_ != nullptr) online_->setCamera(camera_.intrinsics());
     result_->planned_flight_s = timeline_.end_s;
     result_->X_BC = cameraInBody(model_.get(), camera_.id());
     X_CB_ = result_->X_BC.inverse();
@@ -120,8 +126,11 @@ class ClosedLoop {
     RgbdFrame first = render();
     odometry_ = std::make_unique<vo::RgbdOdometry>(camera_.intrinsics(), scenario_.vo, first.X_WC);
     pipeline_ = std::make_unique<VoPipeline>(*odometry_, noise_, reinitialise_, cfg_.pipeline);
+    keepForMap(0, first);
     pipeline_->submit(std::move(first), strip_.count(0) > 0);
     FlightHooks hooks;
+    if (online_ != nullptr)
+      hooks.trajectory = [this]() -> const control::SetpointTrajectory& { return online_->trajectory(); };
     if (fly_on_vo_) hooks.control_state = [this](const FlightLoop&) { return estimator_.state(); };
     hooks.after_step = [this](const FlightLoop& l) { return afterStep(l); };
     const double process_cpu0 = vo::processCpuSeconds();
@@ -149,6 +158,7 @@ class ClosedLoop {
     fillProfile();
     result_->vo_fused = estimator_.fused();
     result_->vo_rejected = estimator_.rejected();
+    if (online_ != nullptr) finishOnline();
     return events();
   }
 
@@ -184,7 +194,9 @@ class ClosedLoop {
     const control::ImuSample sample = imu_.sample(data_.get());
     if (fly_on_vo_) estimator_.propagate(sample);
     if (std::string stop = checkContactsAndBounds(l); !stop.empty()) return stop;
-    if (l.steps() % steps_per_frame_ == 0) cameraTick(l);
+    if (l.steps() % steps_per_frame_ == 0) {
+      if (std::string stop = cameraTick(l); !stop.empty()) return stop;
+    }
     if (interrupt_ != nullptr && interrupt_->load()) {
       interrupted_ = true;
       return "interrupted";
@@ -220,13 +232,15 @@ class ClosedLoop {
   // the controller uses from now on: the VO of frame k-1 overlaps the render of k. A VO pose is
   // fused one camera period after its image; rendering stops once tracking is lost for good (the
   // frames after it are not scored).
-  void cameraTick(const FlightLoop& l) {
+  std::string cameraTick(const FlightLoop& l) {
     ++frame_index_;
     const bool stop_rendering = fly_on_vo_ ? vo_failed_known_ : (!reinitialise_ && pipeline_->failedForGood());
     TickProfile tick;
     double blocked_s = 0.0;  // waiting for the VO stage
     if (!stop_rendering) {
-      blocked_s += pipeline_->submit(render(), strip_.count(frame_index_) > 0);
+      RgbdFrame frame = render();
+      keepForMap(frame_index_, frame);
+      blocked_s += pipeline_->submit(std::move(frame), strip_.count(frame_index_) > 0);
       tick.rendered = true;
     }
     if (fly_on_vo_ && fused_up_to_ < frame_index_ - 1 && !vo_failed_known_) {
@@ -234,6 +248,7 @@ class ClosedLoop {
       fuseResult(frame_index_ - 1);
       blocked_s += seconds(Clock::now() - t);
     }
+    const std::string stop = online_ != nullptr ? planOnline(l) : std::string();
     if (progress_) reportProgress(l);
     const Clock::time_point now = Clock::now();
     const double cpu_now = vo::threadCpuSeconds();
@@ -243,6 +258,52 @@ class ClosedLoop {
     tick_mark_ = now;
     cpu_mark_ = cpu_now;
     ticks_.push_back(tick);
+    return stop;
+  }
+
+  // Online: a copy of every trial.map_every_frames-th frame, mapped once its pose is known.
+  void keepForMap(long k, const RgbdFrame& frame) {
+    if (online_ == nullptr || k % cfg_.online.map_every_frames != 0) return;
+    RgbdFrame copy;
+    copy.t_s = frame.t_s;
+    copy.bgr = frame.bgr.clone();
+    copy.depth_m = frame.depth_m.clone();
+    copy.X_WC = frame.X_WC;
+    map_frames_.emplace(k, std::move(copy));
+  }
+
+  // Online, at a camera tick: maps the previous frame (at the VO's pose, or the true one), then
+  // replans when due. Returns why the flight stops (no route), or "".
+  std::string planOnline(const FlightLoop& l) {
+    const auto kept = map_frames_.find(frame_index_ - 1);
+    if (kept != map_frames_.end()) {
+      RgbdFrame frame = std::move(kept->second);
+      map_frames_.erase(kept);
+      const bool truth = cfg_.online.map_pose == MapPose::kTruth;
+      const bool tracked = truth || (fused_pose_index_ == frame_index_ - 1 && fused_pose_);
+      if (tracked) {
+        if (!truth) frame.X_WC = *fused_pose_;
+        online_->mapFrame(frame, l.time(), timeline_.trajectory_start_s);
+      }
+    }
+    if (l.time() >= cfg_.online.max_flight_s) {
+      time_limit_ = true;
+      return "the flight time limit trial.max_flight_s";
+    }
+    std::string why = online_->replan(l.time(), timeline_.trajectory_start_s);
+    if (why.empty()) return why;
+    result_->no_path = TrialEvent{l.time(), l.state().p_WB, why};
+    return "no path: " + why;
+  }
+
+  // The online part's metrics: the final map against the scene, the flight against the plans.
+  void finishOnline() {
+    std::vector<std::pair<double, Eigen::Vector3d>> flown;
+    for (const FlightSample& f : result_->flight.log) {
+      if (f.on_trajectory) flown.emplace_back(f.t_s, f.estimate.p_WB);
+    }
+    mj_forward(model_.get(), view_.get());
+    result_->online = online_->finish(SceneGeometry(model_.get(), view_.get()), flown);
   }
 
   static double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -266,6 +327,9 @@ class ClosedLoop {
   void fuseResult(long k) {
     const VoPipeline::Done d = pipeline_->result(static_cast<std::size_t>(k));
     fused_up_to_ = k;
+    fused_pose_index_ = k;
+    fused_pose_.reset();
+    if (d.vo.status != vo::TrackingStatus::kLost) fused_pose_ = d.vo.X_WC;
     if (d.vo.status == vo::TrackingStatus::kLost) {
       if (!reinitialise_) vo_failed_known_ = true;  // among the fused results: the same in both modes
       return;
@@ -323,6 +387,10 @@ class ClosedLoop {
     e.flight_reason = result_->flight.reason;
     e.left_bounds = left_bounds_;
     e.vo_lost = result_->vo_lost;
+    e.no_path = result_->no_path;
+    // An online flight stopped for want of a route ended as planned, without one.
+    // ... and so did one stopped at its time limit (a timeout unless it is at the goal).
+    if (result_->no_path || time_limit_) e.flight_completed = true;
     e.final_distance_to_goal_m = result_->final_distance_to_goal_m;
     e.goal_radius_m = cfg_.goal_radius_m;
     e.sim_time_s = result_->sim_time_s;
@@ -368,6 +436,11 @@ class ClosedLoop {
   bool airborne_ = false;
   bool interrupted_ = false;
   bool left_bounds_ = false;
+  OnlinePlanning* online_ = nullptr;
+  bool time_limit_ = false;               // online: stopped at trial.max_flight_s
+  std::map<long, RgbdFrame> map_frames_;  // online: frames waiting for their pose
+  long fused_pose_index_ = -1;            // the last VO result fused, and its pose when tracked
+  std::optional<Eigen::Isometry3d> fused_pose_;
 };
 
 }  // namespace
@@ -378,83 +451,28 @@ std::string plannerLabel(const Scenario& scenario, const TrialOptions& options) 
   return planner::toString(options.planner);
 }
 
-namespace {
-
-// A given path, or an external planner's, smoothed into result->setpoints as a plan's path is
-// (without the homology check: it has no class); false with the status set when that fails.
-bool smoothGivenPath(const Scenario& scenario, std::vector<planner::Pose4> path, const std::string& who,
-                     TrialResult* result) {
-  result->plan.plan.path = std::move(path);
-  smoothPath(scenario, result->plan.plan.path, nullptr, &result->plan);
-  if (!result->plan.trajectory.trajectory) {
-    result->status = TrialStatus::kPlanFailed;
-    result->detail = who + "trajectory generation failed: " + result->plan.trajectory.reason;
-    return false;
-  }
-  result->setpoints = setpoints(result->plan, scenario.planner.trajectory.sample_rate_hz);
-  return true;
-}
-
-// The route to fly into result->setpoints: given, asked of the external planner or planned.
-// False with the status set when there is none.
-bool makeRoute(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
-               const std::atomic<bool>* interrupt, TrialResult* result) {
-  if (!options.given() && !options.external) {
-    result->plan = runPlanner(scenario, map, options.planner, options.seed, options.rrt_samples, options.oracle_option);
-    const planner::Plan& plan = result->plan.plan;
-    if (plan.chosen < 0 || !result->plan.trajectory.trajectory) {
-      result->status = TrialStatus::kPlanFailed;
-      result->detail = plan.chosen < 0 ? std::string("no path: ") + planner::toString(plan.status)
-                                       : "trajectory generation failed: " + result->plan.trajectory.reason;
-      return false;
-    }
-    result->setpoints = setpoints(result->plan, scenario.planner.trajectory.sample_rate_hz);
-    return true;
-  }
-  result->plan.planner = options.planner;
-  result->plan.seed = options.seed;
-  buildPlanningVoxels(scenario, map, &result->plan);
-  if (options.given_trajectory) {
-    checkGivenTrajectory(scenario, *result->plan.voxels, *options.given_trajectory, options.given_file);
-    result->setpoints = options.given_trajectory;
-    return true;
-  }
-  if (options.given_path) {
-    checkGivenPath(scenario, *result->plan.voxels, *options.given_path, options.given_file);
-    return smoothGivenPath(scenario, *options.given_path, "", result);
-  }
-  result->external = askExternalPlanner(scenario, options.map_dir, *result->plan.voxels, options.seed, interrupt);
-  ExternalPlan& ext = *result->external;
-  result->plan.solve_s = ext.total_s();
-  result->plan.plan.topo = std::move(ext.topo);
-  result->plan.plan.chosen_class = ext.homology_class.value_or(-1);
-  if (!ext.ok) {
-    const bool interrupted = interrupt != nullptr && interrupt->load();
-    result->status = interrupted ? TrialStatus::kInterrupted : TrialStatus::kPlanFailed;
-    result->detail = ext.detail;
-    return false;
-  }
-  result->plan.plan.status = planner::PlanStatus::kSolved;
-  if (ext.trajectory) {
-    result->setpoints = ext.trajectory;
-    return true;
-  }
-  return smoothGivenPath(scenario, *ext.path, "external planner " + scenario.planner.external.name + ": ", result);
-}
-
-}  // namespace
-
 TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
                      const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   TrialResult result;
-  if (!makeRoute(scenario, map, options, interrupt, &result)) return result;
+  std::unique_ptr<OnlinePlanning> online;
+  if (scenario.trial.online.online()) {
+    if (options.given() || options.external) {
+      throw InputError(std::string("trial.mode = online: flies the built-in planners only, not ") +
+                       (options.external ? "an external planner" : "a given route"));
+    }
+    online = std::make_unique<OnlinePlanning>(scenario, map, options.planner, options.seed, options.rrt_samples);
+    result.setpoints = online->firstPlan(&result.plan);
+  } else if (!makeRoute(scenario, map, options, interrupt, &result)) {
+    return result;
+  }
   if (interrupt != nullptr && interrupt->load()) {
     result.status = TrialStatus::kInterrupted;
     result.detail = "interrupted after planning";
     return result;
   }
-  ClosedLoop closed_loop(scenario, options, *result.setpoints, &result);
+  ClosedLoop closed_loop(scenario, options, *result.setpoints, &result, online.get());
   TrialEvents events = closed_loop.fly(progress, interrupt);
+  if (online) result.setpoints = online->trajectory();  // what was flown in the end: every plan spliced
   events.goal_error_m = trackedGoalError(result.frames);
   events.path_length_m = flownLength(result.flight);
   events.max_drift_ratio = scenario.trial.max_drift_ratio;
@@ -462,6 +480,8 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   result.status = verdict.status;
   result.detail = verdict.detail;
   const planner::PerceptionPlannerConfig& model = scenario.planner.perception;
+  // Online: the frames are predicted, and the map drawn, from the map the flight built.
+  if (result.online && result.online->final_map) buildPlanningVoxels(scenario, *result.online->final_map, &result.plan);
   for (TrialFrame& f : result.frames) {
     f.predicted = predictFrame(*result.plan.voxels, f.X_WC_true, model.visibility, model.information);
   }

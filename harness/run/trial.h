@@ -23,6 +23,7 @@
 #include "harness/config/scenario.h"
 #include "harness/run/external_plan.h"
 #include "harness/run/frame_prediction.h"
+#include "harness/run/online_planning.h"
 #include "harness/run/plan_run.h"
 #include "harness/run/trial_profile.h"
 #include "harness/run/trial_status.h"
@@ -86,6 +87,8 @@ struct TrialResult {
   std::vector<TrialFrame> frames;  // in time order; after the first loss only while re-initialising
   std::optional<TrialEvent> vo_lost;
   std::optional<TrialEvent> collision;
+  std::optional<TrialEvent> no_path;      // online: the flight stopped without a route
+  std::optional<OnlineResult> online;     // online: plans, map, their metrics (online_planning.h)
   double final_distance_to_goal_m = 0.0;  // true position at the end of the flight
   double sim_time_s = 0.0;
   double flight_wall_s = 0.0;

@@ -193,6 +193,30 @@ nlohmann::ordered_json externalPlanJson(const Scenario& scenario, const TrialOpt
   return plan;
 }
 
+// online.json: every plan of an online trial, for the figures (harness/run/online_planning.h).
+nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
+  nlohmann::ordered_json plans = nlohmann::ordered_json::array();
+  for (const OnlinePlan& p : online.plans) {
+    nlohmann::ordered_json j;
+    j["t_s"] = p.t_s;
+    j["effective_s"] = p.effective_s;
+    j["trigger"] = p.trigger;
+    j["ok"] = p.ok;
+    j["adopted"] = p.adopted;
+    j["detail"] = p.detail;
+    j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
+    j["chosen_class"] = p.chosen_class;
+    j["landmarks"] = p.landmarks;
+    nlohmann::ordered_json path = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < p.path.size(); ++i) {
+      path.push_back({p.path[i].x(), p.path[i].y(), p.path[i].z(), p.path_unknown[i] ? 1 : 0});
+    }
+    j["path"] = path;  // x, y, z, unknown when planned (0/1)
+    plans.push_back(j);
+  }
+  return {{"plans", plans}};
+}
+
 void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {
   if (options.given()) {
     const char* kind = options.givenKind();
@@ -227,6 +251,7 @@ void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& 
   writeFileAtomic(d / "est.tum", vo::toTum(est));
   writeFileAtomic(d / "vo.csv", voCsv(r));
   if (!r.strip.empty()) writeImageAtomic(d / "frames.png", drawFrameStrip(r.strip, r.strip_captions));
+  if (r.online) writeFileAtomic(d / "online.json", onlinePlansJson(*r.online).dump(1) + "\n");
 }
 
 std::string summaryLine(const Scenario& scenario, const TrialOptions& options, const TrialResult& r,
@@ -242,6 +267,7 @@ std::string summaryLine(const Scenario& scenario, const TrialOptions& options, c
          << (scores.goal_error_m ? std::to_string(*scores.goal_error_m).substr(0, 5) + " m" : std::string("n/a"))
          << ", ATE " << scores.ate_rmse_m << " m over " << scores.vo_frames << " frames, plan " << timing.plan_time_s
          << " s, real-time factor " << (r.flight_wall_s > 0 ? r.sim_time_s / r.flight_wall_s : 0.0);
+    if (r.online) line << ", online: " << r.online->plans.size() << " plans";
   }
   line << " -> " << out.string() << "/";
   return line.str();
@@ -292,7 +318,9 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
 
   const fs::path& d = staged.staging();
   writeData(d, scenario, options, r);
-  writeMapLayer(d, sceneMapLayer(scenario.scene, map, scenario.planner.perception.slice_half_height_m));
+  // Online: the map the flight built (planned on in the estimated frame).
+  const planner::FeatureMap& drawn = r.online && r.online->final_map ? *r.online->final_map : map;
+  writeMapLayer(d, sceneMapLayer(scenario.scene, drawn, scenario.planner.perception.slice_half_height_m));
   TrialJobResult result;
   if (r.status == TrialStatus::kInterrupted) {
     writeFileAtomic(d / "INCOMPLETE", "interrupted: " + r.detail + "; these results are partial\n");

@@ -85,6 +85,64 @@ TrialScores scoreTrial(const TrialResult& result) {
   return s;
 }
 
+namespace {
+
+// Sim time at which the true position first came within the goal radius (none: never).
+std::optional<double> timeToGoal(const Scenario& scenario, const TrialResult& result) {
+  for (const FlightSample& f : result.flight.log) {
+    if ((f.state.p_WB - scenario.scene.goal.p_WB).norm() <= scenario.trial.goal_radius_m) return f.t_s;
+  }
+  return std::nullopt;
+}
+
+// metrics.json's `online` object: the plans and the map (deterministic values only).
+nlohmann::ordered_json onlineJson(const Scenario& scenario, const TrialResult& result) {
+  using nlohmann::ordered_json;
+  const OnlineResult& o = *result.online;
+  const OnlineConfig& c = scenario.trial.online;
+  ordered_json j;
+  j["prior_map"] = c.prior_map == PriorMap::kNone ? "none" : c.prior_map == PriorMap::kSurvey ? "survey" : "radius";
+  j["map_pose"] = c.map_pose == MapPose::kTruth ? "truth" : "estimate";
+  j["unknown_space"] = c.unknown_space == UnknownSpace::kFree ? "free" : "blocked";
+  j["plan_latency_s"] = c.plan_latency_s;
+  int ok = 0;
+  int adopted = 0;
+  ordered_json times = ordered_json::array();
+  for (std::size_t i = 0; i < o.plans.size(); ++i) {
+    ok += o.plans[i].ok ? 1 : 0;
+    adopted += o.plans[i].adopted ? 1 : 0;
+    if (i > 0) times.push_back(o.plans[i].t_s);
+  }
+  j["plans"] = o.plans.size();
+  j["plans_without_route"] = static_cast<int>(o.plans.size()) - ok;
+  j["replans"] = o.plans.empty() ? 0 : static_cast<int>(o.plans.size()) - 1;
+  j["plans_flown"] = adopted;  // the first, and those that changed the route
+  j["replan_times_s"] = times;
+  const std::optional<double> reached = timeToGoal(scenario, result);
+  j["time_to_goal_s"] = reached ? ordered_json(*reached) : ordered_json(nullptr);
+  j["keyframes"] = o.keyframes;
+  j["map_coverage"] = o.coverage;
+  j["map_landmarks"] = o.final_map ? o.final_map->landmarks().size() : 0;
+  j["map_occupied_voxels"] = o.occupied_voxels;
+  j["map_error_mean_m"] = o.map_error_mean_m;
+  j["map_error_far_share"] = o.map_error_far_share;
+  j["unknown_share"] = o.unknown_share;
+  return j;
+}
+
+// The wall-clock figures of an online trial: its plans, and its map updates per keyframe and per
+// camera frame (the speed target is the latter).
+void addOnlineTiming(const OnlineResult& o, int frames, nlohmann::ordered_json* timing) {
+  double plan_s = 0.0;
+  for (const OnlinePlan& p : o.plans) plan_s += p.voxel_map_s + p.solve_s + p.trajectory_s;
+  (*timing)["online_plans_s"] = plan_s;
+  (*timing)["map_update_s"] = o.map_update_s;
+  (*timing)["map_update_ms_per_keyframe"] = o.keyframes > 0 ? 1e3 * o.map_update_s / o.keyframes : 0.0;
+  (*timing)["map_update_ms_per_frame"] = frames > 0 ? 1e3 * o.map_update_s / frames : 0.0;
+}
+
+}  // namespace
+
 nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOptions& options,
                                         const TrialResult& result, const TrialScores& scores,
                                         const TrialTiming& timing) {
@@ -146,6 +204,8 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
                  {"height_px", scenario.camera.height_px},
                  {"rate_hz", scenario.trial.camera_rate_hz}};
   j["sim_time_s"] = result.sim_time_s;
+  j["mode"] = result.online ? "online" : "prior";
+  j["online"] = result.online ? onlineJson(scenario, result) : ordered_json(nullptr);
   const double rtf = result.flight_wall_s > 0 ? result.sim_time_s / result.flight_wall_s : 0.0;
   // Wall-clock figures: the documented names (README) at the top level, and all of them under `timing`.
   j["plan_time_s"] = timing.plan_time_s;
@@ -159,6 +219,7 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
                  {"real_time_factor", rtf},
                  {"peak_rss_mb", timing.peak_rss_mb},
                  {"profile", result.profile.toJson()}};
+  if (result.online) addOnlineTiming(*result.online, scores.vo_frames, &j["timing"]);
   return j;
 }
 

@@ -21,6 +21,8 @@ const char* toString(TrialStatus status) {
       return "timeout";
     case TrialStatus::kPlanFailed:
       return "plan_failed";
+    case TrialStatus::kNoPath:
+      return "no_path";
     case TrialStatus::kInterrupted:
       return "incomplete";
   }
@@ -59,6 +61,9 @@ TrialVerdict decideStatus(const TrialEvents& e) {
   } else if (e.vo_lost) {
     v.status = TrialStatus::kVoLost;
     why << "VO lost at t = " << e.vo_lost->t_s << " s at " << formatPoint(e.vo_lost->p_WB) << ": " << e.vo_lost->what;
+  } else if (e.no_path) {
+    v.status = TrialStatus::kNoPath;
+    why << "no path at t = " << e.no_path->t_s << " s at " << formatPoint(e.no_path->p_WB) << ": " << e.no_path->what;
   } else if (e.final_distance_to_goal_m > e.goal_radius_m) {
     v.status = TrialStatus::kTimeout;
     why << "the flight ended " << e.final_distance_to_goal_m << " m from the goal (goal radius " << e.goal_radius_m

@@ -7,7 +7,17 @@
 
 namespace tgnav::harness {
 
-enum class TrialStatus { kSuccess, kDrifted, kVoLost, kCollision, kDiverged, kTimeout, kPlanFailed, kInterrupted };
+enum class TrialStatus {
+  kSuccess,
+  kDrifted,
+  kVoLost,
+  kCollision,
+  kDiverged,
+  kTimeout,
+  kPlanFailed,
+  kNoPath,  // online: the known and unknown space left no route, and the flight stopped
+  kInterrupted
+};
 const char* toString(TrialStatus status);  // "success", "drifted", "vo_lost", ..., "incomplete"
 
 struct TrialEvent {
@@ -24,6 +34,9 @@ struct TrialEvents {
   std::string flight_reason;
   bool left_bounds = false;  // flight_reason says where
   std::optional<TrialEvent> vo_lost;
+  // Online: the planner found no route and the current one was blocked or spent, so the flight
+  // stopped (why, and when).
+  std::optional<TrialEvent> no_path;
   double final_distance_to_goal_m = 0.0;
   double goal_radius_m = 0.5;
   double sim_time_s = 0.0;
@@ -41,7 +54,8 @@ struct TrialVerdict {
   std::string detail;  // one line: what decided it
 };
 
-// Most severe first: interrupted, collision, diverged (or left the scene), VO lost, timeout (the
+// Most severe first: interrupted, collision, diverged (or left the scene), VO lost, no path (online:
+// the flight stopped without a route), timeout (the
 // flight ended outside the goal radius), drifted (the VO tracked to the end, but its goal error
 // exceeds max_drift_ratio times the distance flown: the vehicle arrived without knowing where it
 // was), success.

@@ -126,10 +126,13 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
   const double t0 = timeline.takeoff_s;
   const double climb_s = timeline.climb_end_s - t0;
   result.trajectory_start_s = timeline.trajectory_start_s;
-  const double t_end = timeline.end_s;
+  double t_end = timeline.end_s;
 
   while (loop.time() < t_end - 1e-9) {
     const double t = loop.time();
+    const control::SetpointTrajectory& flown = hooks.trajectory ? hooks.trajectory() : trajectory;
+    if (hooks.trajectory)
+      t_end = result.trajectory_start_s + (flown.endTime() - trajectory.startTime()) + config.hold_s;
     control::TrajectorySetpoint sp;
     bool on_trajectory = false;
     if (t < timeline.climb_end_s) {
@@ -145,8 +148,8 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
       sp.yaw_rate_rad_s = 0.0;
     } else {
       const double tt = trajectory.startTime() + (t - result.trajectory_start_s);
-      sp = trajectory.sample(tt);
-      on_trajectory = tt <= trajectory.endTime();
+      sp = flown.sample(tt);
+      on_trajectory = tt <= flown.endTime();
     }
     const control::VehicleState truth = loop.state();
     const control::VehicleState flown_on = hooks.control_state ? hooks.control_state(loop) : truth;

@@ -99,6 +99,11 @@ struct FlightHooks {
   // the next step reads (qpos, qvel, act, ctrl) alone; recomputing kinematics (mj_kinematics,
   // mj_camlight) is fine, mj_step recomputes them anyway.
   std::function<std::string(const FlightLoop& loop)> after_step;
+  // The trajectory to fly, asked before every step (unset: the one given). It may change during
+  // the flight (an online planner's); every one keeps the given one's time base, and the flight
+  // ends hold_s after the end of the one flown then. The take-off climbs to the given one's first
+  // setpoint.
+  std::function<const control::SetpointTrajectory&()> trajectory;
 };
 
 // When the phases of flyTrajectory begin, from the loop's current time and state.

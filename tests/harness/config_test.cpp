@@ -383,6 +383,42 @@ TEST(ConfigTrial, ImuValidationNamesFieldAndValue) {
   EXPECT_EQ(invalidArgument(imu), "");
 }
 
+TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
+  TrialConfig t;
+  t.online.plan_latency_s = -0.1;
+  EXPECT_EQ(invalidArgument(t), "plan_latency_s = -0.1: must be in [0, 10]");
+  t = TrialConfig{};
+  t.online.replan_period_s = 0.4;  // not beyond the latency: a plan would be asked before the last took effect
+  EXPECT_EQ(invalidArgument(t), "replan_period_s = 0.4: must be > plan_latency_s and <= 60");
+  t = TrialConfig{};
+  t.online.map_every_frames = 0;
+  EXPECT_EQ(invalidArgument(t), "map_every_frames = 0: must be in [1, 100]");
+  t = TrialConfig{};
+  t.online.prior_radius_m = 0.0;
+  EXPECT_EQ(invalidArgument(t), "prior_radius_m = 0: must be > 0");
+  // Online, the vehicle flies on the pose it maps at.
+  t = TrialConfig{};
+  t.online.mode = TrialMode::kOnline;
+  EXPECT_EQ(invalidArgument(t),
+            "state_source = gt: must be vo in online mode with map_pose estimate (an online trial flies on the "
+            "pose it maps at)");
+  t.state_source = StateSource::kVo;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.map_pose = MapPose::kTruth;
+  EXPECT_EQ(invalidArgument(t).rfind("state_source = vo: must be gt in online mode with map_pose truth", 0), 0u);
+  // Prior mode ignores the online keys' pairing with the state source.
+  t.online.mode = TrialMode::kPrior;
+  EXPECT_EQ(invalidArgument(t), "");
+}
+
+TEST(ConfigTrial, UnknownTrialModeNamesKeyAndValue) {
+  const auto file = test::writeFile(test::tempDir() / "trial.yaml", "mode: sideways\n");
+  const std::string msg = inputError([&] { loadTrialConfig(file); });
+  EXPECT_NE(msg.find(file.string() + ":1: key 'mode' has value 'sideways', expected one of prior, online"),
+            std::string::npos)
+      << msg;
+}
+
 TEST(ConfigTrial, TrialValidationNamesDottedFieldAndValue) {
   EXPECT_EQ(invalidArgument(TrialConfig{}), "");
   TrialConfig t;

@@ -296,8 +296,8 @@ TEST(ReportAggregation, CsvHasRawNumbersInSeparateColumns) {
   EXPECT_EQ(header,
             "scene,planner,samples,params,label,trials,successes,vo_success_rate,length_n,length_mean_m,length_std_m,"
             "goal_error_n,goal_error_mean_m,goal_error_std_m,plan_time_n,plan_time_mean_s,plan_time_std_s,ate_n,"
-            "ate_rmse_mean_m,ate_rmse_std_m,success,drifted,vo_lost,collision,diverged,timeout,plan_failed");
-  EXPECT_EQ(line, "storage,proposed,0,,Proposed,2,1,0.5,2,1.5,0.7071067812,1,0.1,0,2,1,0,2,0.05,0,1,0,0,0,0,1,0");
+            "ate_rmse_mean_m,ate_rmse_std_m,success,drifted,vo_lost,collision,diverged,timeout,plan_failed,no_path");
+  EXPECT_EQ(line, "storage,proposed,0,,Proposed,2,1,0.5,2,1.5,0.7071067812,1,0.1,0,2,1,0,2,0.05,0,1,0,0,0,0,1,0,0");
 }
 
 // ---------------------------------------------------------------------------------------------

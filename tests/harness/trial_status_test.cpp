@@ -25,6 +25,22 @@ TEST(DecideStatus, ACleanFlightToTheGoalIsASuccess) {
   EXPECT_EQ(v.detail, "reached the goal (0.10 m from it) with VO tracking all 600 frames");
 }
 
+TEST(DecideStatus, AnOnlineFlightWithoutARouteIsNoPathUnlessItCrashedOrLostTheVo) {
+  TrialEvents e = clean();
+  e.final_distance_to_goal_m = 4.0;
+  e.no_path = event(12.5, "3 plans in a row found no route (last: no path: no_path)");
+  TrialVerdict v = decideStatus(e);
+  EXPECT_EQ(v.status, TrialStatus::kNoPath);
+  EXPECT_STREQ(toString(v.status), "no_path");
+  EXPECT_EQ(v.detail,
+            "no path at t = 12.50 s at (1.00, 2.00, 1.00): 3 plans in a row found no route (last: no path: "
+            "no_path)");
+  e.vo_lost = event(10.0, "too few inliers");
+  EXPECT_EQ(decideStatus(e).status, TrialStatus::kVoLost);
+  e.collision = event(11.0, "wall");
+  EXPECT_EQ(decideStatus(e).status, TrialStatus::kCollision);
+}
+
 TEST(DecideStatus, EndingOutsideTheGoalRadiusIsATimeout) {
   TrialEvents e = clean();
   e.final_distance_to_goal_m = 0.51;

@@ -193,6 +193,31 @@ TEST(VoxelMapLineOfSight, AgreesWithTheWalkEverywhere) {
             << " see their voxel\n";
 }
 
+// An online planner may plan through space it has not observed: with unknown_free, unknown
+// voxels are free (for clearance too), observed ones keep their state.
+TEST(VoxelMapUnknownSpace, UnknownBlocksByDefaultAndIsFreeWhenAsked) {
+  FeatureMap map(kRes);
+  // Observed: a free patch around (-2, 0, 1) and an occupied voxel at (0, 0, 1); the rest unknown.
+  for (double x = -3 + kRes / 2; x < -1; x += kRes) {
+    for (double y = -1 + kRes / 2; y < 1; y += kRes) {
+      for (double z = kRes / 2; z < 2; z += kRes) map.occupancy().updateNode(octomap::point3d(x, y, z), false);
+    }
+  }
+  map.occupancy().updateNode(octomap::point3d(0.05f, 0.05f, 1.05f), true);
+  const Eigen::Vector3d lo(-4, -2, 0), hi(4, 2, 2);
+  const VoxelMap blocked(map, lo, hi);
+  const VoxelMap optimistic(map, lo, hi, -1e9, 1e9, /*unknown_free=*/true);
+  const Eigen::Vector3d seen(-2.05, 0.05, 1.05), unseen(2.05, 0.05, 1.05), wall(0.05, 0.05, 1.05);
+  EXPECT_EQ(blocked.state(seen), VoxelState::kFree);
+  EXPECT_EQ(blocked.state(unseen), VoxelState::kUnknown);
+  EXPECT_EQ(blocked.clearance(unseen), 0.0);
+  EXPECT_EQ(optimistic.state(seen), VoxelState::kFree);
+  EXPECT_EQ(optimistic.state(unseen), VoxelState::kFree);
+  EXPECT_GT(optimistic.clearance(unseen), 0.5);
+  EXPECT_EQ(optimistic.state(wall), VoxelState::kOccupied);
+  EXPECT_EQ(optimistic.clearance(wall), 0.0);
+}
+
 TEST(Detectability, ObservationsOutOfOpportunitiesAtMostOne) {
   Landmark lm;
   lm.observations = 2;

@@ -112,6 +112,28 @@ def write_trial(folder, lost=True, map_layer=True, plan=True, est=True, metrics=
     return folder
 
 
+def write_online(folder):
+    """online.json of `tgnav trial --online`: four plans, two adopted (at 0 s straight along y = 0,
+    through unknown space for x > 0; at 5 s along the flown path), one not, one without a route."""
+    def path(xy, unknown_from=math.inf):
+        return [[x, y, 1.0, int(x > unknown_from)] for x, y in xy]
+
+    straight = [(x, 0.0) for x in np.linspace(-3.0, 3.0, 13)]
+    flown = list(zip(*true_xy(np.linspace(5.0, 10.0, 11))))
+    plans = [
+        {"t_s": 0.0, "effective_s": 0.5, "trigger": "start", "ok": True, "adopted": True, "detail": "",
+         "start": [-3.0, 0.0, 1.0, 0.0], "chosen_class": 0, "landmarks": 0, "path": path(straight, 0.0)},
+        {"t_s": 2.0, "effective_s": 2.5, "trigger": "period", "ok": True, "adopted": False, "detail": "",
+         "start": [-1.8, 0.9, 1.0, 0.0], "chosen_class": 0, "landmarks": 40, "path": path(straight[5:])},
+        {"t_s": 4.0, "effective_s": 4.5, "trigger": "blocked", "ok": False, "adopted": False,
+         "detail": "no route", "start": [-0.6, 1.4, 1.0, 0.0], "chosen_class": None, "landmarks": 60, "path": []},
+        {"t_s": 5.0, "effective_s": 5.5, "trigger": "blocked", "ok": True, "adopted": True, "detail": "",
+         "start": [0.0, 1.5, 1.0, 0.0], "chosen_class": 1, "landmarks": 80, "path": path(flown)},
+    ]
+    write_json(folder, "online.json", {"plans": plans})
+    return folder
+
+
 def write_plan(folder, grid=False, map_layer=True):
     """A scenario plan (classes scored by c_p_min, threshold 6) or a grid plan with a roadmap."""
     os.makedirs(folder, exist_ok=True)
@@ -478,6 +500,80 @@ class PlotsTest(unittest.TestCase):
         mean = line(fig4, "Proposed (1/2)")
         values = np.asarray(mean.get_ydata(), dtype=float)
         np.testing.assert_allclose(values[np.isfinite(values)], EST_OFFSET_M, atol=1e-5)
+
+    # --- online trials: online.json's plans
+
+    def test_online_trial_draws_every_adopted_plan(self):
+        folder = write_online(write_trial(self.folder("online")))
+        figures = tgnav_plots.trial_figures(folder)
+        self.assertEqual(sorted(figures), ["ate", "online_plans", "topdown"])
+        top = figures["topdown"].axes[0]
+        labels = [text.get_text() for text in top.get_legend().get_texts()]
+        self.assertIn("first plan", labels)
+        self.assertIn("plans (colour: time)", labels)
+        self.assertNotIn("planned path", labels)
+        self.assertAlmostEqual(float(np.max(line(top, "flown (true)").get_ydata())), 1.5, places=3)
+        plans = top.collections[0]  # the adopted plans, coloured by their times
+        self.assertEqual(len(plans.get_segments()), 2)
+        np.testing.assert_array_equal(plans.get_array(), [0.0, 5.0])
+        self.assertEqual(len(figures["topdown"].axes), 2)  # and the colour bar
+        rgb, height = rendered(figures["topdown"])
+        self.assertTrue(colour_near(rgb, height, top, (0.0, 1.5), hex_rgb(tgnav_plots.FLOWN)))
+        panels = [ax for ax in figures["online_plans"].axes if ax.axison]
+        self.assertEqual([ax.get_title() for ax in panels], ["t = 0.00 s (start)", "t = 5.00 s (blocked)"])
+        first, second = panels
+        self.assertEqual(len(first.images), 1)  # the map
+        # The flown path up to each plan's time: none at 0 s, to (0, 1.5) at 5 s.
+        flown = [li for li in second.get_lines() if li.get_color() == tgnav_plots.FLOWN]
+        self.assertEqual(len(flown), 1)
+        self.assertAlmostEqual(float(np.nanmax(flown[0].get_xdata())), 0.0, places=6)
+        at_start = [li for li in first.get_lines() if li.get_color() == tgnav_plots.FLOWN]
+        self.assertTrue(all(len(li.get_xdata()) <= 1 for li in at_start))  # gt.tum's first row at most
+        rgb, height = rendered(figures["online_plans"])
+        self.assertTrue(colour_near(rgb, height, first, (-1.5, 0.0), hex_rgb(tgnav_plots.PLANNED)))
+        self.assertTrue(colour_near(rgb, height, first, (1.75, 0.0), hex_rgb(tgnav_plots.UNKNOWN_PATH)))
+        self.assertFalse(colour_near(rgb, height, first, (-1.5, 0.0), hex_rgb(tgnav_plots.UNKNOWN_PATH)))
+        inputs = set(os.listdir(folder))
+        self.assertEqual(run_main("trial", folder), (0, "", ""))
+        self.assert_figures(folder, FIGURES["trial"] + ["online_plans"], "png", inputs)
+
+    def test_trial_without_online_json_has_no_online_plans(self):
+        figures = tgnav_plots.trial_figures(write_trial(self.folder("trial")))
+        self.assertEqual(sorted(figures), ["ate", "topdown"])
+        labels = [text.get_text() for text in figures["topdown"].axes[0].get_legend().get_texts()]
+        self.assertIn("planned path", labels)
+        self.assertNotIn("first plan", labels)
+        self.assertEqual(len(figures["topdown"].axes), 1)  # no colour bar
+
+    def test_bad_online_json_exits_1_naming_the_file(self):
+        def bad_row(doc):
+            doc["plans"][0]["path"][1] = doc["plans"][0]["path"][1][:3]
+            return doc
+
+        def no_adopted(doc):
+            del doc["plans"][1]["adopted"]
+            return doc
+
+        cases = [("plans: expected a list", lambda doc: {"plans": {"t_s": 0.0}}),
+                 ("plans[0].path[1]: expected 4 or more numbers, got 3", bad_row),
+                 ("plans[1]: missing field 'adopted'", no_adopted)]
+        for k, (what, damage) in enumerate(cases):
+            with self.subTest(what=what):
+                folder = write_online(write_trial(self.folder(f"bad{k}")))
+                with open(os.path.join(folder, "online.json")) as f:
+                    write_json(folder, "online.json", damage(json.load(f)))
+                inputs = set(os.listdir(folder))
+                status, out, err = run_main("trial", folder)
+                self.assert_error(status, out, err, os.path.join(folder, "online.json"))
+                self.assertIn(what, err)
+                self.assertEqual(set(os.listdir(folder)), inputs)
+
+    def test_online_plans_shows_at_most_twelve_the_first_and_the_last(self):
+        self.assertEqual(tgnav_plots.pick_evenly(list(range(5)), 12), [0, 1, 2, 3, 4])
+        picked = tgnav_plots.pick_evenly(list(range(40)), 12)
+        self.assertEqual((len(picked), picked[0], picked[-1]), (12, 0, 39))
+        self.assertEqual(picked, sorted(set(picked)))
+        self.assertEqual(len(tgnav_plots.pick_evenly(list(range(13)), 12)), 12)
 
     def test_eval_colours_the_estimate_by_its_error(self):
         fig = tgnav_plots.eval_figures(write_eval(self.folder("eval")))["eval"]

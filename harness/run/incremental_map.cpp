@@ -1,0 +1,238 @@
+#include "harness/run/incremental_map.h"
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "harness/base/clock.h"
+
+namespace tgnav::harness {
+
+namespace {
+
+// Every observed frame's depth is kept at every kViewStridePx-th pixel (in millimetres) to count
+// each landmark's opportunities once all landmarks are known (9.6 KB per frame at 640x480).
+constexpr int kViewStridePx = 8;
+
+// A landmark being accumulated over observations.
+struct Track {
+  Eigen::Vector3d sum_p_W = Eigen::Vector3d::Zero();
+  int observations = 0;
+  Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero();
+  std::array<std::uint8_t, 32> descriptor{};
+  Eigen::Vector3d mean() const { return sum_p_W / observations; }
+};
+
+// Spatial hash of tracks by the cell of their first observation, cell size = merge radius.
+struct CellKey {
+  long x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct CellHash {
+  std::size_t operator()(const CellKey& k) const {
+    return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L);
+  }
+};
+
+// Depth at (u, v) if it and its 3x3 neighbourhood are valid and continuous, else 0.
+float stableDepth(const cv::Mat& depth, int u, int v, double edge_m) {
+  if (u < 1 || v < 1 || u >= depth.cols - 1 || v >= depth.rows - 1) return 0.0f;
+  float lo = 1e9f;
+  float hi = 0.0f;
+  for (int dv = -1; dv <= 1; ++dv) {
+    for (int du = -1; du <= 1; ++du) {
+      const float z = depth.at<float>(v + dv, u + du);
+      if (z <= 0.0f) return 0.0f;
+      lo = std::min(lo, z);
+      hi = std::max(hi, z);
+    }
+  }
+  return (hi - lo) > edge_m ? 0.0f : depth.at<float>(v, u);
+}
+
+}  // namespace
+
+// Merges observations into tracks: the nearest track within the merge radius whose descriptor is
+// close enough, else a new one.
+struct IncrementalMapper::Associator {
+  Associator(double radius, int max_hamming) : radius(radius), max_hamming(max_hamming) {}
+
+  void observe(const Eigen::Vector3d& p_W, const std::array<std::uint8_t, 32>& desc, const Eigen::Vector3d& kf) {
+    const CellKey c = cell(p_W);
+    int best = -1;
+    int best_bits = max_hamming + 1;
+    for (long dx = -1; dx <= 1; ++dx) {
+      for (long dy = -1; dy <= 1; ++dy) {
+        for (long dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find(CellKey{c.x + dx, c.y + dy, c.z + dz});
+          if (it == grid.end()) continue;
+          for (int id : it->second) {
+            if ((tracks[id].mean() - p_W).norm() > radius) continue;
+            const int bits = planner::hammingDistance(tracks[id].descriptor, desc);
+            if (bits < best_bits) {
+              best_bits = bits;
+              best = id;
+            }
+          }
+        }
+      }
+    }
+    if (best >= 0) {
+      tracks[best].sum_p_W += p_W;
+      ++tracks[best].observations;
+      return;
+    }
+    Track t;
+    t.sum_p_W = p_W;
+    t.observations = 1;
+    t.ref_kf_p_W = kf;
+    t.descriptor = desc;
+    grid[c].push_back(static_cast<int>(tracks.size()));
+    tracks.push_back(t);
+  }
+
+  CellKey cell(const Eigen::Vector3d& p) const {
+    return CellKey{static_cast<long>(std::floor(p.x() / radius)), static_cast<long>(std::floor(p.y() / radius)),
+                   static_cast<long>(std::floor(p.z() / radius))};
+  }
+
+  double radius;
+  int max_hamming;
+  std::vector<Track> tracks;
+  std::unordered_map<CellKey, std::vector<int>, CellHash> grid;
+};
+
+// An observed frame as the opportunity count needs it: where the camera was and its depth, sampled.
+struct IncrementalMapper::View {
+  Eigen::Isometry3d X_CW;  // world to camera
+  cv::Mat depth_mm;        // CV_16UC1, pixel (r, c) = depth at image pixel (r, c) * kViewStridePx; 0 invalid
+
+  explicit View(const RgbdFrame& frame) : X_CW(frame.X_WC.inverse()) {
+    const cv::Mat& d = frame.depth_m;
+    depth_mm.create((d.rows + kViewStridePx - 1) / kViewStridePx, (d.cols + kViewStridePx - 1) / kViewStridePx,
+                    CV_16UC1);
+    for (int r = 0; r < depth_mm.rows; ++r) {
+      for (int c = 0; c < depth_mm.cols; ++c) {
+        const double z = d.at<float>(r * kViewStridePx, c * kViewStridePx);
+        depth_mm.at<std::uint16_t>(r, c) =
+            static_cast<std::uint16_t>(z > 0.0 ? std::min(65535.0, std::round(z * 1000.0)) : 0.0);
+      }
+    }
+  }
+
+  // True if the view had p_W in its image (off the detector's border), within range and in front
+  // of the surface its depth shows there (by 0.1 m + 2 % of the range: the landmark is a mean of
+  // observations near that surface, and the sampled depth a pixel or a few away).
+  bool hadInView(const Eigen::Vector3d& p_W, const Intrinsics& k, const MapBuildConfig& config) const {
+    const Eigen::Vector3d p_C = X_CW * p_W;
+    const double z = p_C.z();
+    if (z <= 0.0 || z > config.max_range_m) return false;
+    const double u = k.fx * p_C.x() / z + k.cx;
+    const double v = k.fy * p_C.y() / z + k.cy;
+    const double border = config.features.edge_threshold_px;
+    if (u < border || v < border || u > k.width_px - 1 - border || v > k.height_px - 1 - border) return false;
+    const int c = std::min(depth_mm.cols - 1, static_cast<int>(std::lround(u / kViewStridePx)));
+    const int r = std::min(depth_mm.rows - 1, static_cast<int>(std::lround(v / kViewStridePx)));
+    const double surface = 1e-3 * depth_mm.at<std::uint16_t>(r, c);
+    return surface > 0.0 && z <= surface + 0.1 + 0.02 * z;
+  }
+};
+
+IncrementalMapper::IncrementalMapper(const MapBuildConfig& config, const Intrinsics& k)
+    : config_(config),
+      k_(k),
+      detector_(config.features),
+      tree_(std::make_unique<octomap::OcTree>(config.resolution_m)),
+      associator_(std::make_unique<Associator>(config.merge_radius_m, config.max_hamming)) {}
+
+IncrementalMapper::~IncrementalMapper() = default;
+
+void IncrementalMapper::setCamera(const Intrinsics& k) {
+  if (!views_.empty()) throw std::logic_error("IncrementalMapper::setCamera after the first frame");
+  k_ = k;
+}
+
+int IncrementalMapper::views() const { return static_cast<int>(views_.size()); }
+int IncrementalMapper::tracks() const { return static_cast<int>(associator_->tracks.size()); }
+
+void IncrementalMapper::setPrior(const octomap::OcTree& occupancy, std::vector<planner::Landmark> landmarks) {
+  tree_ = std::make_unique<octomap::OcTree>(occupancy);
+  prior_landmarks_ = std::move(landmarks);
+}
+
+void IncrementalMapper::insertDepth(const RgbdFrame& frame, int stride_px) {
+  const Eigen::Vector3d origin = frame.X_WC.translation();
+  octomap::Pointcloud cloud;
+  for (int v = 0; v < k_.height_px; v += stride_px) {
+    const float* row = frame.depth_m.ptr<float>(v);
+    for (int u = 0; u < k_.width_px; u += stride_px) {
+      const double z = row[u];
+      if (z <= 0.0) continue;
+      const Eigen::Vector3d p_W = frame.X_WC * Eigen::Vector3d((u - k_.cx) / k_.fx * z, (v - k_.cy) / k_.fy * z, z);
+      cloud.push_back(static_cast<float>(p_W.x()), static_cast<float>(p_W.y()), static_cast<float>(p_W.z()));
+    }
+  }
+  tree_->insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()), config_.max_range_m,
+                          /*lazy_eval=*/false, /*discretize=*/true);
+}
+
+void IncrementalMapper::observeFeatures(const RgbdFrame& frame) {
+  const Eigen::Vector3d origin = frame.X_WC.translation();
+  cv::Mat gray;
+  cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+  const vo::Features feats = detector_.detect(gray);
+  keypoints_ += static_cast<long>(feats.keypoints.size());
+  for (std::size_t i = 0; i < feats.keypoints.size(); ++i) {
+    const cv::Point2f& px = feats.keypoints[i].pt;
+    const int u = static_cast<int>(std::lround(px.x));
+    const int v = static_cast<int>(std::lround(px.y));
+    const double z = stableDepth(frame.depth_m, u, v, config_.depth_edge_m);
+    if (z <= 0.0 || z > config_.max_range_m) continue;
+    const Eigen::Vector3d p_W = frame.X_WC * Eigen::Vector3d((px.x - k_.cx) / k_.fx * z, (px.y - k_.cy) / k_.fy * z, z);
+    std::array<std::uint8_t, 32> desc{};
+    std::memcpy(desc.data(), feats.descriptors.ptr<std::uint8_t>(static_cast<int>(i)), 32);
+    associator_->observe(p_W, desc, origin);
+    ++observations_;
+  }
+  views_.emplace_back(frame);
+}
+
+IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTree> tree) const {
+  Built out{planner::FeatureMap(std::move(tree))};
+  std::vector<planner::Landmark> landmarks = prior_landmarks_;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const Track& t : associator_->tracks) {
+    if (t.observations < config_.min_observations) {
+      ++out.dropped_few_observations;
+      continue;
+    }
+    planner::Landmark lm;
+    lm.p_W = t.mean();
+    lm.observations = t.observations;
+    lm.ref_kf_p_W = t.ref_kf_p_W;
+    lm.descriptor = t.descriptor;
+    // Landmark::opportunities: the frames that had it in view, a sum over the frames in order; a
+    // frame may have detected it twice (two keypoints merged into it): never below the detections.
+    int n = 0;
+    for (const View& view : views_) n += view.hadInView(lm.p_W, k_, config_) ? 1 : 0;
+    lm.opportunities = std::max(n, lm.observations);
+    landmarks.push_back(lm);
+  }
+  out.opportunities_s = secondsSince(t0);
+  out.map.setLandmarks(std::move(landmarks));
+  out.dropped_not_embedded = out.map.embedLandmarks(config_.max_shift_m);
+  return out;
+}
+
+IncrementalMapper::Built IncrementalMapper::snapshot() const {
+  return build(std::make_unique<octomap::OcTree>(*tree_));
+}
+
+IncrementalMapper::Built IncrementalMapper::release() { return build(std::move(tree_)); }
+
+}  // namespace tgnav::harness

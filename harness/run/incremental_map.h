@@ -1,0 +1,75 @@
+#pragma once
+// A feature map built frame by frame (paper Sec. IV): depth ray-inserted into an OctoMap, ORB
+// keypoints back-projected at the frame's pose and merged into landmarks, and each landmark's
+// detectability counted over the frames that had it in view. The survey (map_builder.h) feeds it
+// the survey's frames at their true poses; an online trial (online_planning.h) feeds it the onboard
+// camera's keyframes at the pose it maps at, and takes a snapshot whenever it plans.
+#include <octomap/OcTree.h>
+
+#include <memory>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "harness/config/map_build_config.h"
+#include "harness/sim/camera.h"
+#include "planner/feature_map.h"
+#include "vo/features.h"
+
+namespace tgnav::harness {
+
+class IncrementalMapper {
+ public:
+  // config.validate() is the caller's. `k`: the camera whose frames are integrated (setCamera()
+  // may name it later, before the first frame).
+  explicit IncrementalMapper(const MapBuildConfig& config, const Intrinsics& k = Intrinsics{});
+  void setCamera(const Intrinsics& k);
+  ~IncrementalMapper();
+  IncrementalMapper(const IncrementalMapper&) = delete;
+  IncrementalMapper& operator=(const IncrementalMapper&) = delete;
+
+  // Starts from a map known beforehand: its occupancy, and its landmarks as they are (their
+  // detectability counted elsewhere); the frames' landmarks are added to them.
+  void setPrior(const octomap::OcTree& occupancy, std::vector<planner::Landmark> landmarks);
+
+  // Ray-inserts every `stride_px`-th depth pixel of `frame` at frame.X_WC.
+  void insertDepth(const RgbdFrame& frame, int stride_px);
+  // Detects its ORB keypoints, merges those with a stable depth into the landmarks, and keeps a
+  // sampled depth of the view for counting opportunities.
+  void observeFeatures(const RgbdFrame& frame);
+
+  const octomap::OcTree& occupancy() const { return *tree_; }
+  long keypoints() const { return keypoints_; }
+  long observations() const { return observations_; }  // keypoints with usable depth
+  int views() const;                                   // frames whose features were observed
+  int tracks() const;                                  // landmarks before the min_observations cut
+
+  struct Built {
+    planner::FeatureMap map;
+    int dropped_few_observations = 0;
+    int dropped_not_embedded = 0;
+    double opportunities_s = 0.0;  // wall time counting opportunities
+  };
+  // The map so far (a copy; the mapper goes on): the prior's landmarks and the frames' landmarks
+  // seen at least config.min_observations times, their opportunities counted over every observed
+  // frame, embedded in the occupancy.
+  Built snapshot() const;
+  // The same, moving the occupancy out (the mapper is spent).
+  Built release();
+
+ private:
+  struct Associator;
+  struct View;
+  Built build(std::unique_ptr<octomap::OcTree> tree) const;
+
+  MapBuildConfig config_;
+  Intrinsics k_;
+  vo::FeatureDetector detector_;
+  std::unique_ptr<octomap::OcTree> tree_;
+  std::unique_ptr<Associator> associator_;
+  std::vector<View> views_;
+  std::vector<planner::Landmark> prior_landmarks_;
+  long keypoints_ = 0;
+  long observations_ = 0;
+};
+
+}  // namespace tgnav::harness

@@ -1,0 +1,124 @@
+#pragma once
+// Online planning (trial.mode online): the vehicle starts with the map of trial.prior_map, maps
+// the onboard camera's keyframes during flight at the pose of trial.map_pose (its own estimate,
+// or the truth), and plans again on that map every trial.replan_period_s and when the path ahead
+// runs into space newly seen occupied. Plans are made in the frame the vehicle flies in (its
+// estimate); collisions are judged on the true scene by the trial.
+//
+// Time is simulated: the simulation waits while a plan is made, and the plan takes effect
+// trial.plan_latency_s after the state it starts from, while the vehicle flies its current
+// trajectory. The new trajectory starts at rest where the current one is at that time, and replaces
+// it over trial.blend_s by a smoothstep blend of the two (position, velocity and yaw stay
+// continuous). A seed gives the same plans and flight whatever the wall clock.
+//
+// Unknown space is planned through (unknown_space free) or avoided (blocked). The perception model
+// scores the landmarks mapped so far, their detectability counted from the flight's own keyframes;
+// a surface not yet seen has no landmarks, so the proposed planner rates views of it blind (the
+// prior: an unseen surface gives the VO nothing) and prefers routes past what it has seen textured.
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "control/trajectory.h"
+#include "harness/config/scenario.h"
+#include "harness/run/incremental_map.h"
+#include "harness/run/plan_run.h"
+#include "planner/feature_map.h"
+
+namespace tgnav::harness {
+
+class SceneGeometry;
+
+// One plan of an online trial.
+struct OnlinePlan {
+  double t_s = 0.0;          // simulated time it was asked
+  double effective_s = 0.0;  // ... and took (or would have taken) effect
+  std::string trigger;       // "start" | "period" | "blocked"
+  bool ok = false;
+  // Flown: it changed the route (a path ahead blocked, a hold, or a path that leaves the current
+  // one's route by more than kSameRouteM); a plan along the current route is not flown (every
+  // switch restarts from rest).
+  bool adopted = false;
+  std::string detail;                 // why not, when it failed
+  planner::Pose4 start;               // where it starts (the estimated frame)
+  std::vector<Eigen::Vector3d> path;  // its chosen path
+  std::vector<bool> path_unknown;     // per point of `path`: never observed when planned
+  int chosen_class = -1;
+  int landmarks = 0;         // in the map it planned on
+  double voxel_map_s = 0.0;  // wall clock
+  double solve_s = 0.0;
+  double trajectory_s = 0.0;
+};
+
+// What the online part of a trial did, for metrics and figures.
+struct OnlineResult {
+  std::vector<OnlinePlan> plans;
+  int keyframes = 0;          // frames mapped
+  double map_update_s = 0.0;  // wall clock of all map updates
+  std::optional<planner::FeatureMap> final_map;
+  double coverage = 0.0;             // share of the flight band's voxels in the scene bounds observed
+  int occupied_voxels = 0;           // in the final map, inside the bounds widened by 0.5 m
+  double map_error_mean_m = 0.0;     // their centres' mean distance to the true geometry
+  double map_error_far_share = 0.0;  // ... share farther than two voxels from it
+  double unknown_share = 0.0;        // of the flown trajectory: in space unknown when planned
+};
+
+class OnlinePlanning {
+ public:
+  // `survey`: the scene's survey map, for the prior (trial.prior_map). InputError for a planner
+  // the online trial does not run (an oracle class).
+  OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey, planner::PlannerKind planner,
+                 std::uint64_t seed, int rrt_samples);
+  ~OnlinePlanning();
+  OnlinePlanning(const OnlinePlanning&) = delete;
+  OnlinePlanning& operator=(const OnlinePlanning&) = delete;
+
+  // The plan before take-off, from the scene's start on the prior map, into *run (its voxels
+  // stay there for the trial's per-frame predictions). Without a route, the vehicle climbs to the
+  // start's flight height and holds there for a replan period (the returned trajectory) and
+  // replans: it may see one.
+  control::SetpointTrajectory firstPlan(PlanRun* run);
+
+  // The onboard camera, before the first keyframe.
+  void setCamera(const Intrinsics& camera) { mapper_.setCamera(camera); }
+
+  // The trajectory to fly now (its time base is the first trajectory's).
+  const control::SetpointTrajectory& trajectory() const { return *current_; }
+
+  // Maps one keyframe at frame.X_WC, and notes whether the path ahead now runs into occupied space.
+  void mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s);
+
+  // At simulated time t: replans when one is due. Returns why the flight must stop (no route and
+  // the current one blocked or spent), or an empty string.
+  std::string replan(double t_s, double trajectory_start_s);
+
+  // The metrics of the final map against the true scene, and the share of the flight through
+  // space unknown when planned (`flown`: estimated positions on the trajectory, with their times).
+  OnlineResult finish(const SceneGeometry& truth, const std::vector<std::pair<double, Eigen::Vector3d>>& flown);
+
+ private:
+  struct Attempt;
+  Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
+  bool blockedAhead(double tau_from) const;
+  bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
+  double tau(double t_s, double trajectory_start_s) const { return tau0_ + (t_s - trajectory_start_s); }
+
+  const Scenario& scenario_;
+  const OnlineConfig& cfg_;
+  planner::PlannerKind planner_;
+  std::uint64_t seed_;
+  int rrt_samples_;
+  IncrementalMapper mapper_;
+  std::unique_ptr<control::SetpointTrajectory> current_;
+  double tau0_ = 0.0;  // the first trajectory's start: the time base of every later one
+  double next_replan_s_ = 0.0;
+  double pending_until_s_ = -1.0;  // a plan takes effect then; none is asked before
+  bool blocked_ = false;
+  bool holding_ = false;     // flying a hold: no route
+  int failed_in_a_row_ = 0;  // plans without a route since the last one with
+  OnlineResult result_;
+};
+
+}  // namespace tgnav::harness
