@@ -84,6 +84,18 @@ int runTrialCommand(TrialCliOptions& opt) {
   return 0;
 }
 
+// `--online`: trial.mode=online, and the state source the map pose flies on unless `set` names one.
+void addOnline(std::vector<std::string>* set) {
+  bool source_given = false;
+  bool truth = false;
+  for (const std::string& s : *set) {
+    source_given = source_given || s.rfind("trial.state_source=", 0) == 0;
+    truth = truth || s == "trial.map_pose=truth";
+  }
+  set->insert(set->begin(), "trial.mode=online");
+  if (!source_given) set->push_back(truth ? "trial.state_source=gt" : "trial.state_source=vo");
+}
+
 }  // namespace
 
 void addTrialCommand(CLI::App& app) {
@@ -115,7 +127,8 @@ void addTrialCommand(CLI::App& app) {
   auto online = std::make_shared<bool>(false);
   cmd->add_flag("--online", *online,
                 "Plan online: start without a map, map the onboard frames at the VO's pose and replan "
-                "(= --set trial.mode=online --set trial.state_source=vo, before the other --set)");
+                "(= --set trial.mode=online, and trial.state_source=vo, or gt with --set trial.map_pose=truth, "
+                "unless a --set names it)");
   cmd->add_flag("--force", job.force, "Replace the results already in --out");
   cmd->add_option("--frames", job.frames, "Also write frames.png: a strip of N onboard frames (0-64)");
   cmd->add_option("--map", job.map, "Feature map folder from `tgnav map` (default: cached by content)");
@@ -135,7 +148,7 @@ void addTrialCommand(CLI::App& app) {
   cmd->add_flag("--no-figures", opt->no_figures, "Write the data only (a sweep's report draws the figures)");
   cmd->callback([opt, cmd, homology_class, online] {
     if (cmd->count("--class") > 0) opt->homology_class = *homology_class;
-    if (*online) opt->job.set.insert(opt->job.set.begin(), {"trial.mode=online", "trial.state_source=vo"});
+    if (*online) addOnline(&opt->job.set);
     for (const char* given : {"--trajectory", "--path"}) {
       if (cmd->count(given) > 0 && cmd->count("--planner") > 0) {
         throw InputError(std::string(given) + ": flies what it is given; --planner is for planning one");

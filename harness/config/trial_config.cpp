@@ -86,6 +86,7 @@ void OnlineConfig::validate() const {
   require(std::isfinite(replan_period_s) && replan_period_s > plan_latency_s && replan_period_s <= 60.0,
           "replan_period_s", replan_period_s, "must be > plan_latency_s and <= 60");
   require(std::isfinite(blend_s) && blend_s >= 0.0 && blend_s <= 10.0, "blend_s", blend_s, "must be in [0, 10]");
+  require(std::isfinite(commit_s) && commit_s >= 0.0 && commit_s <= 60.0, "commit_s", commit_s, "must be in [0, 60]");
   require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
           "must be in [0, 10]");
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,

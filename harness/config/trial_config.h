@@ -68,6 +68,10 @@ struct OnlineConfig {
   double plan_latency_s = 0.5;
   double replan_period_s = 2.0;  // a plan every this much simulated time, and on events
   double blend_s = 1.0;          // the new trajectory replaces the old one over this long
+  // A plan that changes the route is flown only this long after the last change (unless the path
+  // ahead is blocked or the vehicle holds): the vehicle commits to a route long enough to look at
+  // it, instead of dithering between two whose unknown parts both look free.
+  double commit_s = 6.0;
   // Where the trajectory this far ahead runs through space unknown when planned (or everywhere,
   // with look_ahead_always), the camera turns from the planner's yaw as little as keeps the way
   // there in view (look before flying there); 0: the planner's yaw everywhere.
@@ -87,6 +91,7 @@ struct OnlineConfig {
     a("plan_latency_s", plan_latency_s);
     a("replan_period_s", replan_period_s);
     a("blend_s", blend_s);
+    a("commit_s", commit_s);
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
     a("map_every_frames", map_every_frames);

@@ -26,6 +26,8 @@ class IncrementalMapper {
   ~IncrementalMapper();
   IncrementalMapper(const IncrementalMapper&) = delete;
   IncrementalMapper& operator=(const IncrementalMapper&) = delete;
+  IncrementalMapper(IncrementalMapper&&) = delete;
+  IncrementalMapper& operator=(IncrementalMapper&&) = delete;
 
   // Starts from a map known beforehand: its occupancy, and its landmarks as they are (their
   // detectability counted elsewhere); the frames' landmarks are added to them.

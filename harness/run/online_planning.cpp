@@ -1,6 +1,7 @@
 #include "harness/run/online_planning.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -153,7 +154,9 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.record.effective_s = t_s + cfg_.plan_latency_s;
   a.record.trigger = trigger;
   a.record.start = start;
+  const auto t0 = std::chrono::steady_clock::now();
   IncrementalMapper::Built built = mapper_.snapshot();
+  a.record.snapshot_s = secondsSince(t0);
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   Scenario from_here = scenario_;
   from_here.scene.start = start;
@@ -267,13 +270,15 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   next_replan_s_ = t_s + cfg_.replan_period_s;
   blocked_ = false;
   const bool must_switch = holding_ || a.record.trigger == "blocked";
-  if (a.trajectory && !must_switch && sameRoute(a.run.plan.path, tau_switch)) {
+  const bool committed = t_s < last_change_s_ + cfg_.commit_s;
+  if (a.trajectory && !must_switch && (committed || sameRoute(a.run.plan.path, tau_switch))) {
     failed_in_a_row_ = 0;
     result_.plans.push_back(std::move(a.record));
     return std::string();
   }
   if (a.trajectory) {
     a.record.adopted = true;
+    last_change_s_ = t_s;
     current_ = std::make_unique<control::SetpointTrajectory>(
         control::spliceTrajectory(*current_, *a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s));
     pending_until_s_ = t_eff;

@@ -37,9 +37,9 @@ struct OnlinePlan {
   double effective_s = 0.0;  // ... and took (or would have taken) effect
   std::string trigger;       // "start" | "period" | "blocked"
   bool ok = false;
-  // Flown: it changed the route (a path ahead blocked, a hold, or a path that leaves the current
-  // one's route by more than kSameRouteM); a plan along the current route is not flown (every
-  // switch restarts from rest).
+  // Flown: it changed the route (a path ahead blocked, a hold, or, trial.commit_s after the last
+  // change, a path that leaves the current one's route by more than kSameRouteM); a plan along the
+  // current route is not flown (every switch restarts from rest).
   bool adopted = false;
   std::string detail;                 // why not, when it failed
   planner::Pose4 start;               // where it starts (the estimated frame)
@@ -47,6 +47,7 @@ struct OnlinePlan {
   std::vector<bool> path_unknown;     // per point of `path`: never observed when planned
   int chosen_class = -1;
   int landmarks = 0;         // in the map it planned on
+  double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
   double voxel_map_s = 0.0;  // wall clock
   double solve_s = 0.0;
   double trajectory_s = 0.0;
@@ -74,6 +75,8 @@ class OnlinePlanning {
   ~OnlinePlanning();
   OnlinePlanning(const OnlinePlanning&) = delete;
   OnlinePlanning& operator=(const OnlinePlanning&) = delete;
+  OnlinePlanning(OnlinePlanning&&) = delete;
+  OnlinePlanning& operator=(OnlinePlanning&&) = delete;
 
   // The plan before take-off, from the scene's start on the prior map, into *run (its voxels
   // stay there for the trial's per-frame predictions). Without a route, the vehicle climbs to the
@@ -115,6 +118,7 @@ class OnlinePlanning {
   double tau0_ = 0.0;  // the first trajectory's start: the time base of every later one
   double next_replan_s_ = 0.0;
   double pending_until_s_ = -1.0;  // a plan takes effect then; none is asked before
+  double last_change_s_ = -1e9;    // when the last plan that changed the route was asked
   bool blocked_ = false;
   bool holding_ = false;     // flying a hold: no route
   int failed_in_a_row_ = 0;  // plans without a route since the last one with

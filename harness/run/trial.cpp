@@ -129,8 +129,9 @@ class ClosedLoop {
     keepForMap(0, first);
     pipeline_->submit(std::move(first), strip_.count(0) > 0);
     FlightHooks hooks;
-    if (online_ != nullptr)
+    if (online_ != nullptr) {
       hooks.trajectory = [this]() -> const control::SetpointTrajectory& { return online_->trajectory(); };
+    }
     if (fly_on_vo_) hooks.control_state = [this](const FlightLoop&) { return estimator_.state(); };
     hooks.after_step = [this](const FlightLoop& l) { return afterStep(l); };
     const double process_cpu0 = vo::processCpuSeconds();
@@ -248,7 +249,7 @@ class ClosedLoop {
       fuseResult(frame_index_ - 1);
       blocked_s += seconds(Clock::now() - t);
     }
-    const std::string stop = online_ != nullptr ? planOnline(l) : std::string();
+    std::string stop = online_ != nullptr ? planOnline(l) : std::string();
     if (progress_) reportProgress(l);
     const Clock::time_point now = Clock::now();
     const double cpu_now = vo::threadCpuSeconds();

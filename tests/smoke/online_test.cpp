@@ -67,9 +67,9 @@ TEST(OnlineTrial, FromNoMapReachesTheGoalTheSameWhateverTheThreads) {
 
 TEST(OnlineTrial, MapsAtTheTruePoseOnGroundTruthAndPlansFirstOnASurveyPrior) {
   const auto dir = test::tempDir();
-  const CmdResult truth =
-      shell(trialCommand("--online --seed 3" + kSmall +
-                         " --set trial.map_pose=truth --set trial.state_source=gt --out " + (dir / "truth").string()));
+  // --online flies on ground truth when the map is made at the true pose.
+  const CmdResult truth = shell(
+      trialCommand("--online --seed 3" + kSmall + " --set trial.map_pose=truth --out " + (dir / "truth").string()));
   ASSERT_EQ(truth.rc, 0) << truth.output;
   const nlohmann::json m = readJson(dir / "truth/metrics.json");
   EXPECT_EQ(m["state_source"], "gt");
@@ -95,7 +95,8 @@ TEST(OnlineTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
     std::string expected;
   };
   const std::vector<Case> cases = {
-      {"--online --set trial.map_pose=truth", "state_source = vo: must be gt in online mode with map_pose truth"},
+      {"--online --set trial.map_pose=truth --set trial.state_source=vo",
+       "state_source = vo: must be gt in online mode with map_pose truth"},
       {"--set trial.mode=online", "state_source = gt: must be vo in online mode"},
       {"--online --set trial.plan_latency_s=-1", "plan_latency_s = -1"},
       {"--online --set trial.prior_map=half",
