@@ -131,8 +131,9 @@ FlightResult flyTrajectory(FlightLoop& loop, const control::SetpointTrajectory& 
   while (loop.time() < t_end - 1e-9) {
     const double t = loop.time();
     const control::SetpointTrajectory& flown = hooks.trajectory ? hooks.trajectory() : trajectory;
-    if (hooks.trajectory)
+    if (hooks.trajectory) {
       t_end = result.trajectory_start_s + (flown.endTime() - trajectory.startTime()) + config.hold_s;
+    }
     control::TrajectorySetpoint sp;
     bool on_trajectory = false;
     if (t < timeline.climb_end_s) {
