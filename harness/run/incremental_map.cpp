@@ -20,7 +20,7 @@ namespace {
 constexpr int kViewStridePx = 8;
 
 // A landmark being accumulated over observations.
-struct Track {
+struct LandmarkTrack {
   Eigen::Vector3d sum_p_W = Eigen::Vector3d::Zero();
   int observations = 0;
   Eigen::Vector3d ref_kf_p_W = Eigen::Vector3d::Zero();
@@ -87,7 +87,7 @@ struct IncrementalMapper::Associator {
       ++tracks[best].observations;
       return;
     }
-    Track t;
+    LandmarkTrack t;
     t.sum_p_W = p_W;
     t.observations = 1;
     t.ref_kf_p_W = kf;
@@ -103,7 +103,7 @@ struct IncrementalMapper::Associator {
 
   double radius;
   int max_hamming;
-  std::vector<Track> tracks;
+  std::vector<LandmarkTrack> tracks;
   std::unordered_map<CellKey, std::vector<int>, CellHash> grid;
 };
 
@@ -206,7 +206,7 @@ IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTre
   Built out{planner::FeatureMap(std::move(tree))};
   std::vector<planner::Landmark> landmarks = prior_landmarks_;
   const auto t0 = std::chrono::steady_clock::now();
-  for (const Track& t : associator_->tracks) {
+  for (const LandmarkTrack& t : associator_->tracks) {
     if (t.observations < config_.min_observations) {
       ++out.dropped_few_observations;
       continue;

@@ -67,13 +67,13 @@ nlohmann::ordered_json numberOrNull(double v) {
   return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
 }
 
-struct Camera {
+struct SequenceCamera {
   vo::CameraIntrinsics intrinsics;
   std::string source;  // where it came from
 };
 
 // From --intrinsics (the image size from the first frame) or the sequence's intrinsics.yaml.
-Camera sequenceCamera(Sequence* seq, const std::string& intrinsics) {
+SequenceCamera sequenceCamera(Sequence* seq, const std::string& intrinsics) {
   if (!intrinsics.empty()) {
     const std::vector<double> k = parseNumbers(intrinsics, 4, "--intrinsics", "fx,fy,cx,cy (pixels)");
     if (!(k[0] > 0.0) || !(k[1] > 0.0)) {
@@ -191,7 +191,7 @@ void addTrajectoryMetrics(const Sequence& seq, const Tracking& t, nlohmann::orde
   (*j)["goal_error_m"] = numberOrNull(goal);
 }
 
-nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const Camera& camera,
+nlohmann::ordered_json summaryJson(const VoJob& job, const Sequence& seq, const SequenceCamera& camera,
                                    const vo::OdometryConfig& config, const vo::RgbdOdometry& odometry,
                                    bool start_from_gt, const Tracking& t) {
   const vo::CameraIntrinsics& k = camera.intrinsics;
@@ -246,7 +246,7 @@ VoRunResult runVo(const VoJob& job) {
 
   Sequence seq = loadSequence(job.sequence);
   if (seq.groundtruth_non_increasing > 0) std::fprintf(stderr, "%s\n", nonIncreasingWarning(seq).c_str());
-  const Camera camera = sequenceCamera(&seq, job.intrinsics);
+  const SequenceCamera camera = sequenceCamera(&seq, job.intrinsics);
   Eigen::Isometry3d X_WC0 = Eigen::Isometry3d::Identity();
   std::vector<vo::StampedPose> by_time = seq.groundtruth;
   std::stable_sort(by_time.begin(), by_time.end(),
