@@ -14,12 +14,7 @@ const std::vector<std::pair<std::string, StateSource>>& stateSourceNames() {
   return names;
 }
 
-const char* toString(StateSource source) {
-  for (const auto& [name, s] : stateSourceNames()) {
-    if (s == source) return name.c_str();
-  }
-  return "?";
-}
+const char* toString(StateSource source) { return nameOf(source, stateSourceNames()); }
 
 bool parseStateSource(const std::string& text, StateSource* source) {
   for (const auto& [name, s] : stateSourceNames()) {
@@ -109,7 +104,7 @@ void TrialConfig::validate() const {
     if (state_source != flies_on) {
       throw std::invalid_argument(std::string("state_source = ") + toString(state_source) + ": must be " +
                                   toString(flies_on) + " in online mode with map_pose " +
-                                  (online.map_pose == MapPose::kTruth ? "truth" : "estimate") +
+                                  nameOf(online.map_pose, mapPoseNames()) +
                                   " (an online trial flies on the pose it maps at)");
     }
   }

@@ -10,6 +10,15 @@
 
 namespace tgnav::harness {
 
+// The name of `value` in a table of names such as stateSourceNames() ("?" when absent).
+template <typename E>
+const char* nameOf(E value, const std::vector<std::pair<std::string, E>>& names) {
+  for (const auto& [name, v] : names) {
+    if (v == value) return name.c_str();
+  }
+  return "?";
+}
+
 enum class StateSource { kGroundTruth, kVo };
 // Every source with its name in configs: {"gt", kGroundTruth}, {"vo", kVo}.
 const std::vector<std::pair<std::string, StateSource>>& stateSourceNames();

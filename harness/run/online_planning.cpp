@@ -32,25 +32,31 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   return config;
 }
 
+// Calls fn(p) with the centre of every map voxel that the leaf at `it` covers (a leaf may be a
+// merged cube of many voxels).
+template <typename LeafIterator, typename Fn>
+void forEachVoxel(const LeafIterator& it, double res, const Fn& fn) {
+  const int n = std::max(1, static_cast<int>(std::lround(it.getSize() / res)));
+  const Eigen::Vector3d corner =
+      Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * it.getSize() - 0.5 * res);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      for (int k = 0; k < n; ++k) fn(Eigen::Vector3d(corner + res * Eigen::Vector3d(i, j, k)));
+    }
+  }
+}
+
 // The survey's occupancy within `radius_m` (horizontally) of `centre`, voxel by voxel.
 octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m) {
   const double res = tree.getResolution();
   octomap::OcTree out(res);
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    const int n = std::max(1, static_cast<int>(std::lround(it.getSize() / res)));
-    const Eigen::Vector3d corner =
-        Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * it.getSize() - 0.5 * res);
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j) {
-        for (int k = 0; k < n; ++k) {
-          const Eigen::Vector3d p = corner + res * Eigen::Vector3d(i, j, k);
-          if ((p - centre).head<2>().norm() > radius_m) continue;
-          out.setNodeValue(
-              octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
-              it->getLogOdds(), /*lazy_eval=*/true);
-        }
-      }
-    }
+    forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
+      if ((p - centre).head<2>().norm() > radius_m) return;
+      out.setNodeValue(
+          octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
+          it->getLogOdds(), /*lazy_eval=*/true);
+    });
   }
   out.updateInnerOccupancy();
   return out;
@@ -349,21 +355,13 @@ OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,
   long n = 0;
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     if (!tree.isNodeOccupied(*it)) continue;
-    const int cells = std::max(1, static_cast<int>(std::lround(it.getSize() / res)));
-    const Eigen::Vector3d corner =
-        Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * it.getSize() - 0.5 * res);
-    for (int i = 0; i < cells; ++i) {
-      for (int j = 0; j < cells; ++j) {
-        for (int k = 0; k < cells; ++k) {
-          const Eigen::Vector3d p = corner + res * Eigen::Vector3d(i, j, k);
-          if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-          const double d = std::max(0.0, truth.signedDistance(p));
-          sum += d;
-          far += d > 2.0 * res ? 1 : 0;
-          ++n;
-        }
-      }
-    }
+    forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return;
+      const double d = std::max(0.0, truth.signedDistance(p));
+      sum += d;
+      far += d > 2.0 * res ? 1 : 0;
+      ++n;
+    });
   }
   out.occupied_voxels = static_cast<int>(n);
   out.map_error_mean_m = n > 0 ? sum / static_cast<double>(n) : 0.0;

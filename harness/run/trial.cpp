@@ -235,7 +235,12 @@ class ClosedLoop {
   // frames after it are not scored).
   std::string cameraTick(const FlightLoop& l) {
     ++frame_index_;
-    const bool stop_rendering = fly_on_vo_ ? vo_failed_known_ : (!reinitialise_ && pipeline_->failedForGood());
+    // Online at the true pose, the map needs every frame whatever the VO does (and when the VO
+    // stage noticed its loss depends on the wall clock).
+    const bool map_at_truth = online_ != nullptr && !fly_on_vo_;
+    const bool stop_rendering = fly_on_vo_     ? vo_failed_known_
+                                : map_at_truth ? false
+                                               : (!reinitialise_ && pipeline_->failedForGood());
     TickProfile tick;
     double blocked_s = 0.0;  // waiting for the VO stage
     if (!stop_rendering) {

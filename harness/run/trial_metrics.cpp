@@ -101,9 +101,9 @@ nlohmann::ordered_json onlineJson(const Scenario& scenario, const TrialResult& r
   const OnlineResult& o = *result.online;
   const OnlineConfig& c = scenario.trial.online;
   ordered_json j;
-  j["prior_map"] = c.prior_map == PriorMap::kNone ? "none" : c.prior_map == PriorMap::kSurvey ? "survey" : "radius";
-  j["map_pose"] = c.map_pose == MapPose::kTruth ? "truth" : "estimate";
-  j["unknown_space"] = c.unknown_space == UnknownSpace::kFree ? "free" : "blocked";
+  j["prior_map"] = nameOf(c.prior_map, priorMapNames());
+  j["map_pose"] = nameOf(c.map_pose, mapPoseNames());
+  j["unknown_space"] = nameOf(c.unknown_space, unknownSpaceNames());
   j["plan_latency_s"] = c.plan_latency_s;
   int ok = 0;
   int adopted = 0;
