@@ -86,6 +86,10 @@ struct OnlineConfig {
   // there in view (look before flying there); 0: the planner's yaw everywhere.
   double look_ahead_s = 2.0;
   bool look_ahead_always = false;
+  // A plan along the current route (not flown: a switch restarts from rest) renews the views
+  // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
+  // it is now, then the look-ahead rule on that map. false: the views of the plan last flown.
+  bool renew_views = false;
   int map_every_frames = 4;     // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;        // ... every Nth pixel of its depth, in both directions
   double max_flight_s = 120.0;  // simulated time from take-off; beyond it the flight stops
@@ -103,6 +107,7 @@ struct OnlineConfig {
     a("commit_s", commit_s);
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
+    a("renew_views", renew_views);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("max_flight_s", max_flight_s);

@@ -127,6 +127,37 @@ std::string ioFailure(ChildProcess::Io io, ChildProcess* child, double budget_s)
   }
 }
 
+// One request and its response on a running planner. Fills out->call_s; returns the failure ("" when
+// the response parsed).
+std::string exchange(ChildProcess* child, const PlanRequestMessage& request, double timeout_s,
+                     const std::atomic<bool>* interrupt, ExternalPlan* out, PlanResponse* response) {
+  const auto t_call = Clock::now();
+  const auto deadline = t_call + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
+  std::string failure;
+  ChildProcess::Io io = child->write(planRequestLine(request), deadline, interrupt);
+  std::string line;
+  if (io == ChildProcess::Io::kOk) io = child->readLine(&line, deadline, kMaxResponseBytes, interrupt);
+  if (io != ChildProcess::Io::kOk) {
+    failure = ioFailure(io, child, timeout_s);
+  } else {
+    try {
+      *response = parsePlanResponse(line, request.id);
+    } catch (const ProtocolError& e) {
+      failure = e.what();
+    }
+  }
+  out->call_s = secondsSince(t_call);
+  return failure;
+}
+
+// Asks the planner to shut down and stops it (at once after a failure). Fills out->ended, stop_s.
+void shutDown(ChildProcess* child, bool failed, ExternalPlan* out) {
+  const auto t_stop = Clock::now();
+  (void)child->write(shutdownLine(), Clock::now() + std::chrono::milliseconds(100));
+  out->ended = child->stop(failed ? 0.0 : kShutdownGrace_s);
+  out->stop_s = secondsSince(t_stop);
+}
+
 // The conversation: start, one request, one response, shutdown. Fills `out`; returns the failure
 // ("" when the response parsed).
 std::string converse(const Scenario& scenario, const PlanRequestMessage& request, const fs::path& tmp,
@@ -135,29 +166,11 @@ std::string converse(const Scenario& scenario, const PlanRequestMessage& request
   const fs::path err = tmp / "stderr.txt";
   std::string failure;
   const auto t_start = Clock::now();
-  const auto deadline =
-      t_start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(ext.timeout_s));
   try {
     ChildProcess child(ext.command, ext.dir, err);
     out->start_s = secondsSince(t_start);
-    const auto t_call = Clock::now();
-    ChildProcess::Io io = child.write(planRequestLine(request), deadline, interrupt);
-    std::string line;
-    if (io == ChildProcess::Io::kOk) io = child.readLine(&line, deadline, kMaxResponseBytes, interrupt);
-    if (io != ChildProcess::Io::kOk) {
-      failure = ioFailure(io, &child, ext.timeout_s);
-    } else {
-      try {
-        *response = parsePlanResponse(line, request.id);
-      } catch (const ProtocolError& e) {
-        failure = e.what();
-      }
-    }
-    out->call_s = secondsSince(t_call);
-    const auto t_stop = Clock::now();
-    (void)child.write(shutdownLine(), Clock::now() + std::chrono::milliseconds(100));
-    out->ended = child.stop(failure.empty() ? kShutdownGrace_s : 0.0);
-    out->stop_s = secondsSince(t_stop);
+    failure = exchange(&child, request, ext.timeout_s, interrupt, out, response);
+    shutDown(&child, !failure.empty(), out);
   } catch (const std::runtime_error& e) {  // the system could not start it
     failure = e.what();
   }
@@ -165,40 +178,25 @@ std::string converse(const Scenario& scenario, const PlanRequestMessage& request
   return failure;
 }
 
-}  // namespace
-
-ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_dir, const planner::VoxelMap& voxels,
-                                std::uint64_t seed, const std::atomic<bool>* interrupt) {
+// The planner's answer judged: its own failure, a class it was not sent, a route the map refuses.
+// Sets out->ok and the route, or out->detail.
+void judge(const Scenario& scenario, const planner::VoxelMap& voxels, PlanResponse response, ExternalPlan* out) {
   const ExternalPlannerConfig& ext = scenario.planner.external;
   const std::string who = "external planner " + ext.name + ": ";
-  ExternalPlan out;
-  const TempDir tmp;
-  const auto t0 = Clock::now();
-  const ClearanceBand band = clearanceBand(scenario);
-  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp.path() / "occupancy.yaml", tmp.path() / "occupancy.pgm");
-  if (ext.classes) out.topo = writeClasses(scenario, voxels, seed, tmp.path() / "classes.json");
-  const PlanRequestMessage request = requestFor(scenario, map_dir, tmp.path(), seed, ext.classes);
-  out.prepare_s = secondsSince(t0);
-
-  PlanResponse response;
-  const std::string failure = converse(scenario, request, tmp.path(), interrupt, &out, &response);
-  if (!failure.empty()) {
-    out.detail = who + failure;
-    return out;
-  }
-  out.planner_s = response.solve_time_s;
-  out.reason = response.reason;
-  out.scores = response.scores;
-  out.homology_class = response.homology_class;
+  out->planner_s = response.solve_time_s;
+  out->reason = response.reason;
+  out->scores = response.scores;
+  out->homology_class = response.homology_class;
   if (!response.ok) {
-    out.detail = who + "no path" + (response.reason.empty() ? std::string() : ": " + response.reason);
-    return out;
+    out->no_path = true;
+    out->detail = who + "no path" + (response.reason.empty() ? std::string() : ": " + response.reason);
+    return;
   }
-  const auto classes = static_cast<int>(out.topo.classes.size());
+  const auto classes = static_cast<int>(out->topo.classes.size());
   if (ext.classes && response.homology_class && *response.homology_class >= classes) {
-    out.detail = who + "invalid response: homology_class " + std::to_string(*response.homology_class) +
-                 " is not one of the " + std::to_string(classes) + " classes sent";
-    return out;
+    out->detail = who + "invalid response: homology_class " + std::to_string(*response.homology_class) +
+                  " is not one of the " + std::to_string(classes) + " classes sent";
+    return;
   }
   const auto t_check = Clock::now();
   std::string refused;
@@ -211,14 +209,103 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
   } catch (const InputError& e) {
     refused = e.what();
   }
-  out.check_s = secondsSince(t_check);
+  out->check_s = secondsSince(t_check);
   if (!refused.empty()) {
-    out.detail = who + "route refused: " + refused;
+    out->detail = who + "route refused: " + refused;
+    return;
+  }
+  out->path = std::move(response.path);
+  out->trajectory = std::move(response.trajectory);
+  out->ok = true;
+}
+
+}  // namespace
+
+ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_dir, const planner::VoxelMap& voxels,
+                                std::uint64_t seed, const std::atomic<bool>* interrupt) {
+  const ExternalPlannerConfig& ext = scenario.planner.external;
+  ExternalPlan out;
+  const TempDir tmp;
+  const auto t0 = Clock::now();
+  const ClearanceBand band = clearanceBand(scenario);
+  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp.path() / "occupancy.yaml", tmp.path() / "occupancy.pgm");
+  if (ext.classes) out.topo = writeClasses(scenario, voxels, seed, tmp.path() / "classes.json");
+  const PlanRequestMessage request = requestFor(scenario, map_dir, tmp.path(), seed, ext.classes);
+  out.prepare_s = secondsSince(t0);
+
+  PlanResponse response;
+  const std::string failure = converse(scenario, request, tmp.path(), interrupt, &out, &response);
+  if (!failure.empty()) {
+    out.detail = "external planner " + ext.name + ": " + failure;
     return out;
   }
-  out.path = std::move(response.path);
-  out.trajectory = std::move(response.trajectory);
-  out.ok = true;
+  judge(scenario, voxels, std::move(response), &out);
+  return out;
+}
+
+struct ExternalPlannerSession::Impl {
+  TempDir tmp;
+  std::unique_ptr<ChildProcess> child;
+  int next_id = 1;
+  std::string failure;  // why it was stopped
+};
+
+bool ExternalPlannerSession::stopped() const { return !impl_->failure.empty(); }
+
+ExternalPlannerSession::ExternalPlannerSession(const Scenario& scenario)
+    : scenario_(scenario), impl_(std::make_unique<Impl>()) {}
+
+ExternalPlannerSession::~ExternalPlannerSession() {
+  if (!impl_->child) return;
+  ExternalPlan ignored;
+  shutDown(impl_->child.get(), false, &ignored);
+}
+
+ExternalPlan ExternalPlannerSession::ask(const planner::Pose4& start, const planner::FeatureMap& map,
+                                         const planner::VoxelMap& voxels, std::uint64_t seed,
+                                         const std::atomic<bool>* interrupt) {
+  const ExternalPlannerConfig& ext = scenario_.planner.external;
+  Scenario from_here = scenario_;
+  from_here.scene.start = start;
+  ExternalPlan out;
+  if (stopped()) {
+    out.detail = "external planner " + ext.name + ": " + impl_->failure;
+    return out;
+  }
+  const fs::path& tmp = impl_->tmp.path();
+  const auto t0 = Clock::now();
+  fs::create_directories(tmp / "map");
+  map.save(tmp / "map");
+  const ClearanceBand band = clearanceBand(from_here);
+  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp / "occupancy.yaml", tmp / "occupancy.pgm");
+  if (ext.classes) out.topo = writeClasses(from_here, voxels, seed, tmp / "classes.json");
+  PlanRequestMessage request = requestFor(from_here, tmp / "map", tmp, seed, ext.classes);
+  request.id = impl_->next_id++;
+  out.prepare_s = secondsSince(t0);
+
+  std::string failure;
+  PlanResponse response;
+  const fs::path err = tmp / "stderr.txt";
+  try {
+    if (!impl_->child) {
+      const auto t_start = Clock::now();
+      impl_->child = std::make_unique<ChildProcess>(ext.command, ext.dir, err);
+      out.start_s = secondsSince(t_start);
+    }
+    failure = exchange(impl_->child.get(), request, ext.timeout_s, interrupt, &out, &response);
+  } catch (const std::runtime_error& e) {  // the system could not start it
+    failure = e.what();
+  }
+  if (!failure.empty()) {
+    // A planner that failed once is not asked again.
+    if (impl_->child) shutDown(impl_->child.get(), true, &out);
+    impl_->child.reset();
+    impl_->failure = failure;
+    out.stderr_tail = fileTail(err);
+    out.detail = "external planner " + ext.name + ": " + failure;
+    return out;
+  }
+  judge(from_here, voxels, std::move(response), &out);
   return out;
 }
 

@@ -10,12 +10,14 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "control/trajectory.h"
 #include "harness/config/scenario.h"
+#include "planner/feature_map.h"
 #include "planner/planner.h"
 #include "planner/pose4.h"
 #include "planner/voxel_map.h"
@@ -31,6 +33,7 @@ struct ExternalPlan {
   std::optional<int> homology_class;  // as the planner reported it
   std::vector<double> scores;         // per point, as reported
   std::string reason;                 // as reported ("" when none)
+  bool no_path = false;               // the planner answered that it found none (status no_path)
   planner::TopoPlan topo;             // the classes it was sent (planner.external.classes)
   double prepare_s = 0.0;             // writing the map slice (and classes)
   double start_s = 0.0;               // starting the process
@@ -49,5 +52,31 @@ struct ExternalPlan {
 ExternalPlan askExternalPlanner(const Scenario& scenario, const std::filesystem::path& map_dir,
                                 const planner::VoxelMap& voxels, std::uint64_t seed,
                                 const std::atomic<bool>* interrupt = nullptr);
+
+// One external planner process asked again and again, for an online trial's plans (the same
+// protocol; request ids count up from 1): started at the first ask, asked to shut down when the
+// session ends. Each ask sends the map as it is then (map.bt and landmarks.csv written into the
+// session's temporary folder, the occupancy slice, the classes if asked). An answer "no path" or a
+// route the map refuses is that plan's failure; a planner that hangs past its budget, exits,
+// crashes or writes garbage is stopped and not asked again (ExternalPlan::stopped).
+class ExternalPlannerSession {
+ public:
+  explicit ExternalPlannerSession(const Scenario& scenario);
+  ~ExternalPlannerSession();
+  ExternalPlannerSession(const ExternalPlannerSession&) = delete;
+  ExternalPlannerSession& operator=(const ExternalPlannerSession&) = delete;
+  ExternalPlannerSession(ExternalPlannerSession&&) = delete;
+  ExternalPlannerSession& operator=(ExternalPlannerSession&&) = delete;
+
+  // A route from `start` to the scenario's goal on `map` (`voxels`: buildPlanningVoxels of it).
+  ExternalPlan ask(const planner::Pose4& start, const planner::FeatureMap& map, const planner::VoxelMap& voxels,
+                   std::uint64_t seed, const std::atomic<bool>* interrupt = nullptr);
+  bool stopped() const;  // it failed: later asks fail at once
+
+ private:
+  struct Impl;
+  const Scenario& scenario_;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace tgnav::harness

@@ -8,6 +8,7 @@
 
 #include "harness/base/clock.h"
 #include "harness/base/errors.h"
+#include "harness/run/look_ahead.h"
 #include "harness/sim/scene_geometry.h"
 
 namespace tgnav::harness {
@@ -70,66 +71,29 @@ control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double du
   return control::SetpointTrajectory({0.0, duration_s}, {sp, sp});
 }
 
-// Where `trajectory` look_ahead_s ahead (or half that) runs through space `map` has not observed,
-// the yaw turns as little as it must from the planner's for the way there to lie within
-// `half_fov_rad` of the camera's axis (the camera looks before the vehicle flies there); the yaws are then smoothed
-// over a moving window of kYawWindowS (on the unit circle) and the yaw rates are their differences. Nothing changes
-// where the way ahead is known, nor where the vehicle hardly moves.
-constexpr double kYawWindowS = 1.0;
-control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
-                                             const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
-                                             bool always) {
-  const std::vector<double>& t = trajectory.times();
-  std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
-  if (look_ahead_s <= 0.0 || t.size() < 3) return trajectory;
-  std::vector<double> yaw(sp.size());
-  bool changed = false;
-  for (std::size_t i = 0; i < sp.size(); ++i) {
-    yaw[i] = sp[i].yaw_rad;
-    const Eigen::Vector3d far = trajectory.sample(t[i] + look_ahead_s).p_WB;
-    const Eigen::Vector3d near = trajectory.sample(t[i] + 0.5 * look_ahead_s).p_WB;
-    const Eigen::Vector2d way = (far - sp[i].p_WB).head<2>();
-    if (way.norm() < 0.1 || (!always && map.isKnown(far) && map.isKnown(near))) continue;
-    // The least turn from the planner's yaw that keeps the way ahead in the camera's field of view.
-    const double heading = std::atan2(way.y(), way.x());
-    yaw[i] = heading + std::clamp(std::remainder(yaw[i] - heading, 2.0 * M_PI), -half_fov_rad, half_fov_rad);
-    changed = true;
-  }
-  if (!changed) return trajectory;
-  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
-  const auto half = static_cast<std::ptrdiff_t>(std::lround(0.5 * kYawWindowS / dt));
-  const auto n = static_cast<std::ptrdiff_t>(sp.size());
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, i - half); j <= std::min(n - 1, i + half); ++j) {
-      sum += Eigen::Vector2d(std::cos(yaw[static_cast<std::size_t>(j)]), std::sin(yaw[static_cast<std::size_t>(j)]));
-    }
-    if (sum.norm() > 1e-6) sp[static_cast<std::size_t>(i)].yaw_rad = std::atan2(sum.y(), sum.x());
-  }
-  for (std::size_t i = 0; i < sp.size(); ++i) {
-    const std::size_t lo = i == 0 ? 0 : i - 1;
-    const std::size_t hi = std::min(sp.size() - 1, i + 1);
-    sp[i].yaw_rate_rad_s = std::remainder(sp[hi].yaw_rad - sp[lo].yaw_rad, 2.0 * M_PI) / (t[hi] - t[lo]);
-  }
-  return control::SetpointTrajectory(t, std::move(sp));
-}
+// How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
+// is looked for when a plan's yaw is carried over to it (OnlinePlanning::renewViews).
+constexpr double kRenewWindowS = 5.0;
 
 }  // namespace
 
 struct OnlinePlanning::Attempt {
   OnlinePlan record;
   PlanRun run;
-  std::optional<control::SetpointTrajectory> trajectory;
+  std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
+  std::optional<control::SetpointTrajectory> raw;         // the planner's
+  std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
 };
 
 OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey,
-                               planner::PlannerKind planner, std::uint64_t seed, int rrt_samples)
+                               planner::PlannerKind planner, std::uint64_t seed, int rrt_samples, bool external)
     : scenario_(scenario),
       cfg_(scenario.trial.online),
       planner_(planner),
       seed_(seed),
       rrt_samples_(rrt_samples),
-      mapper_(onlineMapConfig(survey)) {
+      mapper_(onlineMapConfig(survey)),
+      external_(external ? std::make_unique<ExternalPlannerSession>(scenario) : nullptr) {
   if (scenario.planner.oracle_class >= 0) {
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +
                      ": an online trial plans again on the map it builds, whose classes change; use trial.mode prior");
@@ -154,6 +118,14 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
 
 OnlinePlanning::~OnlinePlanning() = default;
 
+control::SetpointTrajectory OnlinePlanning::lookAhead(const control::SetpointTrajectory& trajectory,
+                                                      const planner::FeatureMap& map) const {
+  // The way ahead within the horizontal field of view, 10 deg inside its edge.
+  const double half_fov = std::max(0.0, 0.5 * scenario_.planner.perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+  return lookWhereUnknown(trajectory, map, cfg_.look_ahead_s, half_fov, cfg_.look_ahead_always,
+                          scenario_.planner.trajectory.max_yaw_rate_rad_s);
+}
+
 OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double t_s, const std::string& trigger) {
   Attempt a;
   a.record.t_s = t_s;
@@ -166,31 +138,77 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   Scenario from_here = scenario_;
   from_here.scene.start = start;
-  a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
-                     cfg_.unknown_space == UnknownSpace::kFree);
-  a.record.voxel_map_s = a.run.voxel_map_s;
-  a.record.solve_s = a.run.solve_s;
-  a.record.trajectory_s = a.run.trajectory_s;
-  const planner::Plan& plan = a.run.plan;
-  if (plan.chosen < 0 || !a.run.trajectory.trajectory) {
-    a.record.detail = plan.chosen < 0 ? std::string("no path: ") + planner::toString(plan.status)
-                                      : "trajectory generation failed: " + a.run.trajectory.reason;
-    return a;
+  const double rate_hz = scenario_.planner.trajectory.sample_rate_hz;
+  if (external_) {
+    if (!askExternal(from_here, built.map, &a)) return a;
+  } else {
+    a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
+                       cfg_.unknown_space == UnknownSpace::kFree);
+    a.record.voxel_map_s = a.run.voxel_map_s;
+    a.record.solve_s = a.run.solve_s;
+    a.record.trajectory_s = a.run.trajectory_s;
+    if (a.run.plan.chosen < 0 || !a.run.trajectory.trajectory) {
+      a.record.detail = a.run.plan.chosen < 0 ? std::string("no path: ") + planner::toString(a.run.plan.status)
+                                              : "trajectory generation failed: " + a.run.trajectory.reason;
+      return a;
+    }
+    a.raw = setpoints(a.run, rate_hz);
   }
   a.record.ok = true;
-  a.record.chosen_class = plan.chosen_class;
-  for (const planner::Pose4& p : plan.path) {
+  a.record.chosen_class = a.run.plan.chosen_class;
+  for (const planner::Pose4& p : a.run.plan.path) {
     a.record.path.push_back(p.p_WB);
     a.record.path_unknown.push_back(!built.map.isKnown(p.p_WB));
   }
-  // The way ahead within the horizontal field of view, 10 deg inside its edge.
-  const double half_fov = std::max(0.0, 0.5 * scenario_.planner.perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
-  a.trajectory = lookWhereUnknown(setpoints(a.run, scenario_.planner.trajectory.sample_rate_hz), built.map,
-                                  cfg_.look_ahead_s, half_fov, cfg_.look_ahead_always);
+  // An external planner's yaw is its own: the look-ahead rule is the built-in planners'.
+  a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map);
+  a.map = std::move(built.map);
   return a;
 }
 
+bool OnlinePlanning::askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a) {
+  a->run.planner = planner_;
+  a->run.seed = seed_;
+  buildPlanningVoxels(from_here, map, &a->run, cfg_.unknown_space == UnknownSpace::kFree);
+  a->record.voxel_map_s = a->run.voxel_map_s;
+  ExternalPlan ext = external_->ask(from_here.scene.start, map, *a->run.voxels, seed_);
+  a->record.solve_s = ext.total_s();
+  if (!ext.ok) {
+    a->record.detail = ext.detail;
+    if (external_->stopped()) planner_failure_ = ext.detail;
+    return false;
+  }
+  a->run.plan.status = planner::PlanStatus::kSolved;
+  a->run.plan.chosen_class = ext.homology_class.value_or(-1);
+  if (ext.trajectory) {
+    // Flown as given, from the switch on; its positions every kBlockedStepS stand for its path.
+    a->raw = std::move(ext.trajectory);
+    for (double t = a->raw->startTime(); t < a->raw->endTime() + kBlockedStepS; t += kBlockedStepS) {
+      const control::TrajectorySetpoint sp = a->raw->sample(std::min(t, a->raw->endTime()));
+      a->run.plan.path.push_back(planner::Pose4{sp.p_WB, sp.yaw_rad});
+    }
+    return true;
+  }
+  a->run.plan.path = std::move(*ext.path);
+  smoothPath(from_here, a->run.plan.path, nullptr, &a->run);
+  a->record.trajectory_s = a->run.trajectory_s;
+  if (!a->run.trajectory.trajectory) {
+    a->record.detail = "external planner " + scenario_.planner.external.name +
+                       ": trajectory generation failed: " + a->run.trajectory.reason;
+    return false;
+  }
+  a->raw = setpoints(a->run, scenario_.planner.trajectory.sample_rate_hz);
+  return true;
+}
+
+bool OnlinePlanning::goalObserved() const {
+  const Eigen::Vector3d& g = scenario_.scene.goal.p_WB;
+  return mapper_.occupancy().search(static_cast<float>(g.x()), static_cast<float>(g.y()), static_cast<float>(g.z())) !=
+         nullptr;
+}
+
 control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
+  goal_seen_ = goalObserved();  // a prior map may have it
   planner::Pose4 start = scenario_.scene.start;
   Attempt a = plan(start, 0.0, "start");
   next_replan_s_ = cfg_.replan_period_s;
@@ -244,17 +262,54 @@ bool OnlinePlanning::sameRoute(const std::vector<planner::Pose4>& path, double t
   return true;
 }
 
+void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
+  const std::vector<double>& t = current_->times();
+  const std::vector<control::TrajectorySetpoint>& from = a.raw->setpoints();
+  const auto window =
+      static_cast<std::size_t>(std::lround(kRenewWindowS * scenario_.planner.trajectory.sample_rate_hz));
+  std::vector<double> tt;
+  std::vector<control::TrajectorySetpoint> sp;
+  std::size_t j = 0;  // the plan's point matched last: matches move forward along it
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < tau_switch - 1e-9) continue;
+    control::TrajectorySetpoint s = current_->setpoints()[i];
+    double best = std::numeric_limits<double>::infinity();
+    const std::size_t j0 = j;
+    for (std::size_t k = j0; k < std::min(from.size(), j0 + window); ++k) {
+      const double d = (from[k].p_WB - s.p_WB).squaredNorm();
+      if (d < best) {
+        best = d;
+        j = k;
+      }
+    }
+    s.yaw_rad = from[j].yaw_rad;
+    tt.push_back(t[i]);
+    sp.push_back(s);
+  }
+  if (tt.size() < 3) return;
+  smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
+  current_ = std::make_unique<control::SetpointTrajectory>(control::spliceTrajectory(
+      *current_, lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map), tau_switch, cfg_.blend_s));
+}
+
 void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s) {
   const auto t0 = std::chrono::steady_clock::now();
   mapper_.insertDepth(frame, cfg_.map_stride_px);
   mapper_.observeFeatures(frame);
   ++result_.keyframes;
   if (!blocked_) blocked_ = blockedAhead(tau(t_s, trajectory_start_s));
+  if (!goal_seen_) {
+    goal_seen_ = goalObserved();
+    goal_event_ = goal_seen_;
+  }
   result_.map_update_s += secondsSince(t0);
 }
 
 std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
-  if (t_s < pending_until_s_ - 1e-9 || (t_s < next_replan_s_ - 1e-9 && !blocked_)) return std::string();
+  if (!planner_failure_.empty()) return planner_failure_;
+  if (t_s < pending_until_s_ - 1e-9 || (t_s < next_replan_s_ - 1e-9 && !blocked_ && !goal_event_)) {
+    return std::string();
+  }
   const planner::Pose4& goal = scenario_.scene.goal;
   const double t_eff = t_s + cfg_.plan_latency_s;
   const bool before_start = t_eff <= trajectory_start_s;
@@ -272,13 +327,20 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     blocked_ = false;
     return std::string();
   }
-  Attempt a = plan(start, t_s, blocked_ ? "blocked" : "period");
+  Attempt a = plan(start, t_s, blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period");
   next_replan_s_ = t_s + cfg_.replan_period_s;
   blocked_ = false;
+  goal_event_ = false;
   const bool must_switch = holding_ || a.record.trigger == "blocked";
   const bool committed = t_s < last_change_s_ + cfg_.commit_s;
-  if (a.trajectory && !must_switch && (committed || sameRoute(a.run.plan.path, tau_switch))) {
+  const bool same = a.trajectory && !before_start && sameRoute(a.run.plan.path, tau_switch);
+  if (a.trajectory && !must_switch && (committed || same)) {
     failed_in_a_row_ = 0;
+    if (cfg_.renew_views && same) {
+      renewViews(a, tau_switch);
+      a.record.views_renewed = true;
+      pending_until_s_ = t_eff;
+    }
     result_.plans.push_back(std::move(a.record));
     return std::string();
   }

@@ -1,9 +1,9 @@
 #pragma once
 // Online planning (trial.mode online): the vehicle starts with the map of trial.prior_map, maps
 // the onboard camera's keyframes during flight at the pose of trial.map_pose (its own estimate,
-// or the truth), and plans again on that map every trial.replan_period_s and when the path ahead
-// runs into space newly seen occupied. Plans are made in the frame the vehicle flies in (its
-// estimate); collisions are judged on the true scene by the trial.
+// or the truth), and plans again on that map every trial.replan_period_s, when the path ahead
+// runs into space newly seen occupied, and when the goal is first observed. Plans are made in the frame the vehicle
+// flies in (its estimate); collisions are judged on the true scene by the trial.
 //
 // Time is simulated: the simulation waits while a plan is made, and the plan takes effect
 // trial.plan_latency_s after the state it starts from, while the vehicle flies its current
@@ -23,6 +23,7 @@
 
 #include "control/trajectory.h"
 #include "harness/config/scenario.h"
+#include "harness/run/external_plan.h"
 #include "harness/run/incremental_map.h"
 #include "harness/run/plan_run.h"
 #include "planner/feature_map.h"
@@ -35,12 +36,16 @@ class SceneGeometry;
 struct OnlinePlan {
   double t_s = 0.0;          // simulated time it was asked
   double effective_s = 0.0;  // ... and took (or would have taken) effect
-  std::string trigger;       // "start" | "period" | "blocked"
+  std::string trigger;       // "start" | "period" | "blocked" | "goal_seen"
   bool ok = false;
   // Flown: it changed the route (a path ahead blocked, a hold, or, trial.commit_s after the last
   // change, a path that leaves the current one's route by more than kSameRouteM); a plan along the
   // current route is not flown (every switch restarts from rest).
   bool adopted = false;
+  // A plan along the current route that was not flown still renews the views ahead: the current
+  // trajectory's positions are kept and its yaw ahead becomes the new plan's at the nearest point
+  // (then the look-ahead rule on the current map), blended in over trial.blend_s.
+  bool views_renewed = false;
   std::string detail;                 // why not, when it failed
   planner::Pose4 start;               // where it starts (the estimated frame)
   std::vector<Eigen::Vector3d> path;  // its chosen path
@@ -70,8 +75,10 @@ class OnlinePlanning {
  public:
   // `survey`: the scene's survey map, for the prior (trial.prior_map). InputError for a planner
   // the online trial does not run (an oracle class).
+  // `external`: scenario.planner.external plans (one process, asked at every plan) instead of
+  // `planner`.
   OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey, planner::PlannerKind planner,
-                 std::uint64_t seed, int rrt_samples);
+                 std::uint64_t seed, int rrt_samples, bool external = false);
   ~OnlinePlanning();
   OnlinePlanning(const OnlinePlanning&) = delete;
   OnlinePlanning& operator=(const OnlinePlanning&) = delete;
@@ -97,6 +104,10 @@ class OnlinePlanning {
   // the current one blocked or spent), or an empty string.
   std::string replan(double t_s, double trajectory_start_s);
 
+  // Why the external planner was stopped (it hung, crashed, wrote garbage), or "": the trial then
+  // ends in plan_failed.
+  const std::string& plannerFailure() const { return planner_failure_; }
+
   // The metrics of the final map against the true scene, and the share of the flight through
   // space unknown when planned (`flown`: estimated positions on the trajectory, with their times).
   OnlineResult finish(const SceneGeometry& truth, const std::vector<std::pair<double, Eigen::Vector3d>>& flown);
@@ -104,8 +115,13 @@ class OnlinePlanning {
  private:
   struct Attempt;
   Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
+  bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
+  bool goalObserved() const;
   bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
+  void renewViews(const Attempt& a, double tau_switch);
+  control::SetpointTrajectory lookAhead(const control::SetpointTrajectory& trajectory,
+                                        const planner::FeatureMap& map) const;
   double tau(double t_s, double trajectory_start_s) const { return tau0_ + (t_s - trajectory_start_s); }
 
   const Scenario& scenario_;
@@ -114,12 +130,16 @@ class OnlinePlanning {
   std::uint64_t seed_;
   int rrt_samples_;
   IncrementalMapper mapper_;
+  std::unique_ptr<ExternalPlannerSession> external_;
+  std::string planner_failure_;  // the external planner's, when it was stopped
   std::unique_ptr<control::SetpointTrajectory> current_;
   double tau0_ = 0.0;  // the first trajectory's start: the time base of every later one
   double next_replan_s_ = 0.0;
   double pending_until_s_ = -1.0;  // a plan takes effect then; none is asked before
   double last_change_s_ = -1e9;    // when the last plan that changed the route was asked
   bool blocked_ = false;
+  bool goal_seen_ = false;   // the goal's voxel has been observed
+  bool goal_event_ = false;  // ... by the last keyframe: a plan is due
   bool holding_ = false;     // flying a hold: no route
   int failed_in_a_row_ = 0;  // plans without a route since the last one with
   OnlineResult result_;

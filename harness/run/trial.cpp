@@ -462,11 +462,9 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   TrialResult result;
   std::unique_ptr<OnlinePlanning> online;
   if (scenario.trial.online.online()) {
-    if (options.given() || options.external) {
-      throw InputError(std::string("trial.mode = online: flies the built-in planners only, not ") +
-                       (options.external ? "an external planner" : "a given route"));
-    }
-    online = std::make_unique<OnlinePlanning>(scenario, map, options.planner, options.seed, options.rrt_samples);
+    if (options.given()) throw InputError("trial.mode = online: plans again on the map it builds, not a given route");
+    online = std::make_unique<OnlinePlanning>(scenario, map, options.planner, options.seed, options.rrt_samples,
+                                              options.external);
     result.setpoints = online->firstPlan(&result.plan);
   } else if (!makeRoute(scenario, map, options, interrupt, &result)) {
     return result;
@@ -485,6 +483,10 @@ TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, c
   const TrialVerdict verdict = decideStatus(events);
   result.status = verdict.status;
   result.detail = verdict.detail;
+  if (online && !online->plannerFailure().empty() && result.status == TrialStatus::kNoPath) {
+    result.status = TrialStatus::kPlanFailed;  // the external planner failed, not the map
+    result.detail = online->plannerFailure();
+  }
   const planner::PerceptionPlannerConfig& model = scenario.planner.perception;
   // Online: the frames are predicted, and the map drawn, from the map the flight built.
   if (result.online && result.online->final_map) buildPlanningVoxels(scenario, *result.online->final_map, &result.plan);

@@ -203,6 +203,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["trigger"] = p.trigger;
     j["ok"] = p.ok;
     j["adopted"] = p.adopted;
+    j["views_renewed"] = p.views_renewed;
     j["detail"] = p.detail;
     j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
     j["chosen_class"] = p.chosen_class;

@@ -107,16 +107,19 @@ nlohmann::ordered_json onlineJson(const Scenario& scenario, const TrialResult& r
   j["plan_latency_s"] = c.plan_latency_s;
   int ok = 0;
   int adopted = 0;
+  int renewed = 0;
   ordered_json times = ordered_json::array();
   for (std::size_t i = 0; i < o.plans.size(); ++i) {
     ok += o.plans[i].ok ? 1 : 0;
     adopted += o.plans[i].adopted ? 1 : 0;
+    renewed += o.plans[i].views_renewed ? 1 : 0;
     if (i > 0) times.push_back(o.plans[i].t_s);
   }
   j["plans"] = o.plans.size();
   j["plans_without_route"] = static_cast<int>(o.plans.size()) - ok;
   j["replans"] = o.plans.empty() ? 0 : static_cast<int>(o.plans.size()) - 1;
   j["plans_flown"] = adopted;  // the first, and those that changed the route
+  j["plans_renewing_views"] = renewed;
   j["replan_times_s"] = times;
   const std::optional<double> reached = timeToGoal(scenario, result);
   j["time_to_goal_s"] = reached ? ordered_json(*reached) : ordered_json(nullptr);

@@ -3,6 +3,8 @@
 // metrics whatever the thread count; the map at the true pose; a survey prior; bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -12,6 +14,7 @@
 namespace tgnav {
 namespace {
 
+namespace fs = std::filesystem;
 using test::CmdResult;
 CmdResult shell(const std::string& cmd) { return test::runShell(cmd); }
 
@@ -61,6 +64,17 @@ TEST(OnlineTrial, FromNoMapFliesMapsAndReplansTheSameWhateverTheThreads) {
   EXPECT_EQ(readText(dir / "a/online.json"), readText(dir / "b/online.json"));
   EXPECT_EQ(readText(dir / "a/gt.tum"), readText(dir / "b/gt.tum"));
   EXPECT_EQ(readText(dir / "a/trajectory.csv"), readText(dir / "b/trajectory.csv"));
+  // The camera turns no faster than the trajectory's yaw-rate limit (0.6 rad/s), look-ahead and
+  // splices included (before the limit: 1.39 rad/s on this flight, a 1 s swing to the way ahead).
+  std::istringstream rows(readText(dir / "a/trajectory.csv"));
+  std::string row;
+  std::getline(rows, row);
+  ASSERT_EQ(row, "t,x,y,z,yaw,vx,vy,vz,ax,ay,az,yaw_rate");
+  double max_yaw_rate = 0.0;
+  while (std::getline(rows, row)) {
+    max_yaw_rate = std::max(max_yaw_rate, std::abs(std::stod(row.substr(row.rfind(',') + 1))));
+  }
+  EXPECT_LE(max_yaw_rate, 0.6 + 0.05);
   const nlohmann::json plans = readJson(dir / "a/online.json")["plans"];
   ASSERT_EQ(static_cast<int>(plans.size()), o["plans"].get<int>());
   EXPECT_EQ(plans[0]["trigger"], "start");
@@ -92,6 +106,73 @@ TEST(OnlineTrial, MapsAtTheTruePoseOnGroundTruthAndPlansFirstOnASurveyPrior) {
   EXPECT_FALSE(std::filesystem::exists(dir / "prior/online.json"));
 }
 
+TEST(OnlineTrial, ARadiusPriorKeepsTheSurveyNearTheStartOnly) {
+  // Short flights (trial.max_flight_s): the first plan's map is what is checked.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall + " --set trial.max_flight_s=1";
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.prior_map=survey --out " + (dir / "survey").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.prior_map=radius --set trial.prior_radius_m=3 --out " +
+                               (dir / "near").string()))
+                .rc,
+            0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.prior_map=radius --set trial.prior_radius_m=100 --out " +
+                               (dir / "all").string()))
+                .rc,
+            0);
+  const auto first = [&](const char* name) {
+    return readJson(dir / name / "online.json")["plans"][0]["landmarks"].get<int>();
+  };
+  std::cout << "[ figure   ] first plan's landmarks: survey " << first("survey") << ", within 3 m " << first("near")
+            << ", within 100 m " << first("all") << "\n";
+  EXPECT_GT(first("near"), 0);
+  EXPECT_LT(first("near"), first("survey") / 2);
+  EXPECT_EQ(first("all"), first("survey"));  // a radius beyond the scene keeps it all
+  EXPECT_EQ(readJson(dir / "near/metrics.json")["online"]["prior_map"], "radius");
+}
+
+TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
+  const auto dir = test::tempDir();
+  // The example A* planner behind a guard that makes a second start of the command fail.
+  const std::string astar = std::string(TGNAV_SOURCE_DIR) + "/scripts/planners/astar_planner.py";
+  const std::string once = "test -e " + (dir / "started").string() + " && exit 3; touch " + (dir / "started").string() +
+                           "; exec /usr/bin/python3 " + astar;
+  const CmdResult run =
+      shell(trialCommand("--online --seed 3" + kSmall + " --set trial.max_flight_s=12 --planner-command '" + once +
+                         "' --planner-name astar --out " + (dir / "astar").string()));
+  ASSERT_EQ(run.rc, 0) << run.output;
+  const nlohmann::json m = readJson(dir / "astar/metrics.json");
+  EXPECT_EQ(m["planner"], "astar");
+  EXPECT_NE(m["status"], "plan_failed") << m["detail"];
+  const nlohmann::json plans = readJson(dir / "astar/online.json")["plans"];
+  ASSERT_GE(plans.size(), 4U);
+  for (const nlohmann::json& p : plans) EXPECT_TRUE(p["ok"].get<bool>()) << p["detail"];
+  EXPECT_GE(m["online"]["plans_flown"].get<int>(), 2);
+
+  // A planner that answers "no path" once, then exits: the flight holds, then ends in plan_failed.
+  const fs::path quits = dir / "quits.py";
+  std::ofstream(quits) << "import json, sys\n"
+                          "n = 0\n"
+                          "for line in sys.stdin:\n"
+                          "    req = json.loads(line)\n"
+                          "    if req['type'] == 'shutdown':\n"
+                          "        break\n"
+                          "    n += 1\n"
+                          "    if n == 2:\n"
+                          "        sys.exit(7)\n"
+                          "    print(json.dumps({'protocol': 'tgnav-planner', 'version': 1, 'id': req['id'],\n"
+                          "                      'status': 'no_path', 'reason': 'not yet'}), flush=True)\n";
+  const CmdResult quit =
+      shell(trialCommand("--online --seed 3" + kSmall + " --planner-command '/usr/bin/python3 " + quits.string() +
+                         "' --planner-name quits --out " + (dir / "quits").string()));
+  ASSERT_EQ(quit.rc, 0) << quit.output;
+  const nlohmann::json q = readJson(dir / "quits/metrics.json");
+  EXPECT_EQ(q["status"], "plan_failed");
+  EXPECT_NE(q["detail"].get<std::string>().find("external planner quits: exited with status 7"), std::string::npos)
+      << q["detail"];
+  const nlohmann::json first = readJson(dir / "quits/online.json")["plans"][0];
+  EXPECT_EQ(first["detail"], "external planner quits: no path: not yet");
+}
+
 TEST(OnlineTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
   const auto dir = test::tempDir();
   struct Case {
@@ -106,7 +187,8 @@ TEST(OnlineTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
       {"--online --set trial.prior_map=half",
        "'trial.prior_map' has value 'half', expected one of none, survey, radius"},
       {"--online --class 0", "planner.oracle_class = 0: an online trial plans again"},
-      {"--online --planner-command true", "trial.mode = online: flies the built-in planners only"},
+      {"--online --trajectory " + std::string(TGNAV_SOURCE_DIR) + "/configs/trajectories/smoke_around_pillar.csv",
+       "trial.mode = online: plans again on the map it builds, not a given route"},
   };
   int i = 0;
   for (const Case& c : cases) {

@@ -1,0 +1,72 @@
+#include "harness/run/look_ahead.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace tgnav::harness {
+
+namespace {
+constexpr double kYawWindowS = 1.0;  // the smoothing window
+}  // namespace
+
+void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<control::TrajectorySetpoint>* sp) {
+  std::vector<control::TrajectorySetpoint>& s = *sp;
+  const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+  const auto half = static_cast<std::ptrdiff_t>(std::lround(0.5 * kYawWindowS / dt));
+  const auto n = static_cast<std::ptrdiff_t>(s.size());
+  std::vector<double> yaw(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) yaw[i] = s[i].yaw_rad;
+  std::vector<double> y(s.size());  // smoothed, unwrapped
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, i - half); j <= std::min(n - 1, i + half); ++j) {
+      sum += Eigen::Vector2d(std::cos(yaw[static_cast<std::size_t>(j)]), std::sin(yaw[static_cast<std::size_t>(j)]));
+    }
+    const auto k = static_cast<std::size_t>(i);
+    const double smoothed = sum.norm() > 1e-6 ? std::atan2(sum.y(), sum.x()) : yaw[k];
+    y[k] = k == 0 ? smoothed : y[k - 1] + std::remainder(smoothed - y[k - 1], 2.0 * M_PI);
+  }
+  for (std::size_t i = s.size() - 1; i-- > 0;) {
+    const double step = max_rate * (t[i + 1] - t[i]);
+    y[i] = std::clamp(y[i], y[i + 1] - step, y[i + 1] + step);
+  }
+  const double shift = std::remainder(yaw[0] - y[0], 2.0 * M_PI);
+  y[0] += shift;
+  for (std::size_t i = 1; i < s.size(); ++i) {
+    const double step = max_rate * (t[i] - t[i - 1]);
+    y[i] = std::clamp(y[i], y[i - 1] - step, y[i - 1] + step);
+  }
+  for (std::size_t i = 0; i < s.size(); ++i) s[i].yaw_rad = y[i];
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const std::size_t lo = i == 0 ? 0 : i - 1;
+    const std::size_t hi = std::min(s.size() - 1, i + 1);
+    s[i].yaw_rate_rad_s = (y[hi] - y[lo]) / (t[hi] - t[lo]);
+  }
+}
+
+control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
+                                             const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
+                                             bool always, double max_yaw_rate) {
+  const std::vector<double>& t = trajectory.times();
+  std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
+  if (look_ahead_s <= 0.0 || t.size() < 3) return trajectory;
+  bool changed = false;
+  for (std::size_t i = 0; i < sp.size(); ++i) {
+    const Eigen::Vector3d far = trajectory.sample(t[i] + look_ahead_s).p_WB;
+    const Eigen::Vector3d near = trajectory.sample(t[i] + 0.5 * look_ahead_s).p_WB;
+    const Eigen::Vector2d way = (far - sp[i].p_WB).head<2>();
+    if (way.norm() < 0.1 || (!always && map.isKnown(far) && map.isKnown(near))) continue;
+    // The least turn from the planner's yaw that keeps the way ahead in the camera's field of view.
+    const double heading = std::atan2(way.y(), way.x());
+    sp[i].yaw_rad =
+        heading + std::clamp(std::remainder(sp[i].yaw_rad - heading, 2.0 * M_PI), -half_fov_rad, half_fov_rad);
+    changed = true;
+  }
+  if (!changed) return trajectory;
+  smoothYaw(t, max_yaw_rate, &sp);
+  return control::SetpointTrajectory(t, std::move(sp));
+}
+
+}  // namespace tgnav::harness
