@@ -114,6 +114,9 @@ struct OnlineConfig {
   }
 
   bool online() const { return mode == TrialMode::kOnline; }
+  // Whether a trial needs the scene's survey feature map: an online trial from no map does not (it
+  // takes only the map resolution, the survey's default).
+  bool needsSurvey() const { return !online() || prior_map != PriorMap::kNone; }
   void validate() const;
 };
 

@@ -57,17 +57,22 @@ fs::path selfExe() {
   return exe;
 }
 
-// Builds each scene's feature map once, before the trials that share it start.
+// Builds each scene's feature map once, before the trials that share it start (only for scenes
+// with a trial that needs it: an online trial from no map does not).
 void prebuildMaps(const SweepRun& run) {
-  std::map<std::string, const SweepTrial*> scenes;  // a trial of each scene
-  for (std::size_t i : run.todo) scenes.emplace(run.trials[i].scene, &run.trials[i]);
-  const fs::path cache = run.map_cache.empty() ? defaultCacheDir() : fs::path(run.map_cache);
-  for (const auto& [scene, trial] : scenes) {
+  std::map<std::string, Scenario> scenes;  // a trial's scenario of each scene that needs its map
+  for (std::size_t i : run.todo) {
+    const SweepTrial& trial = run.trials[i];
+    if (scenes.count(trial.scene) != 0) continue;
     std::vector<std::string> set;  // the trial's own settings: one may name another scene
-    set.reserve(trial->set.size());
-    for (const auto& [key, value] : trial->set) set.push_back(key + "=" + value);
+    set.reserve(trial.set.size());
+    for (const auto& [key, value] : trial.set) set.push_back(key + "=" + value);
     const YamlDoc overrides = YamlDoc::fromOverrides(set);
-    const Scenario s = loadScenario(trial->scenario, &overrides);
+    Scenario s = loadScenario(trial.scenario, &overrides);
+    if (s.trial.online.needsSurvey()) scenes.emplace(trial.scene, std::move(s));
+  }
+  const fs::path cache = run.map_cache.empty() ? defaultCacheDir() : fs::path(run.map_cache);
+  for (const auto& [scene, s] : scenes) {
     bool told = false;
     const std::string& name = scene;  // a structured binding cannot be captured (C++17)
     cachedFeatureMap(s.scene, MapBuildConfig{}, cache, [&](int, int) {

@@ -53,7 +53,9 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
   std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
   if (look_ahead_s <= 0.0 || t.size() < 3) return trajectory;
   bool changed = false;
-  for (std::size_t i = 0; i < sp.size(); ++i) {
+  // The first setpoint keeps its yaw: it is the vehicle's own where the trajectory starts (and the
+  // yaw it takes off with); the turn toward the way ahead follows within the rate limit.
+  for (std::size_t i = 1; i < sp.size(); ++i) {
     const Eigen::Vector3d far = trajectory.sample(t[i] + look_ahead_s).p_WB;
     const Eigen::Vector3d near = trajectory.sample(t[i] + 0.5 * look_ahead_s).p_WB;
     const Eigen::Vector2d way = (far - sp[i].p_WB).head<2>();
@@ -66,6 +68,34 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
   }
   if (!changed) return trajectory;
   smoothYaw(t, max_yaw_rate, &sp);
+  return control::SetpointTrajectory(t, std::move(sp));
+}
+
+control::SetpointTrajectory limitYawRate(const control::SetpointTrajectory& trajectory, double from_s,
+                                         double max_rate) {
+  const std::vector<double>& t = trajectory.times();
+  std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
+  std::vector<bool> changed(sp.size(), false);
+  bool any = false;
+  for (std::size_t i = 1; i < sp.size(); ++i) {
+    if (t[i] <= from_s) continue;
+    const double step = max_rate * (t[i] - t[i - 1]);
+    const double wanted = sp[i - 1].yaw_rad + std::remainder(sp[i].yaw_rad - sp[i - 1].yaw_rad, 2.0 * M_PI);
+    const double yaw = std::clamp(wanted, sp[i - 1].yaw_rad - step, sp[i - 1].yaw_rad + step);
+    if (yaw != wanted) {
+      changed[i] = true;
+      any = true;
+    }
+    sp[i].yaw_rad = yaw;
+  }
+  if (!any) return trajectory;
+  for (std::size_t i = 0; i < sp.size(); ++i) {
+    const bool near = changed[i] || (i > 0 && changed[i - 1]) || (i + 1 < sp.size() && changed[i + 1]);
+    if (!near) continue;
+    const std::size_t lo = i == 0 ? 0 : i - 1;
+    const std::size_t hi = std::min(sp.size() - 1, i + 1);
+    sp[i].yaw_rate_rad_s = std::clamp((sp[hi].yaw_rad - sp[lo].yaw_rad) / (t[hi] - t[lo]), -max_rate, max_rate);
+  }
   return control::SetpointTrajectory(t, std::move(sp));
 }
 

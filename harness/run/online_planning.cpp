@@ -214,7 +214,8 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   next_replan_s_ = cfg_.replan_period_s;
   if (a.trajectory) {
     a.record.adopted = true;
-    current_ = std::make_unique<control::SetpointTrajectory>(*a.trajectory);
+    current_ = std::make_unique<control::SetpointTrajectory>(
+        limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
   } else {
     // No route yet: climb to the flight height and look.
     start.p_WB.z() = scenario_.scene.flight_height_m;
@@ -288,8 +289,13 @@ void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   }
   if (tt.size() < 3) return;
   smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
-  current_ = std::make_unique<control::SetpointTrajectory>(control::spliceTrajectory(
-      *current_, lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map), tau_switch, cfg_.blend_s));
+  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map), tau_switch, cfg_.blend_s);
+}
+
+void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
+  current_ = std::make_unique<control::SetpointTrajectory>(
+      limitYawRate(control::spliceTrajectory(*current_, next, tau_switch, blend_s), tau_switch,
+                   scenario_.planner.trajectory.max_yaw_rate_rad_s));
 }
 
 void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s) {
@@ -347,8 +353,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   if (a.trajectory) {
     a.record.adopted = true;
     last_change_s_ = t_s;
-    current_ = std::make_unique<control::SetpointTrajectory>(
-        control::spliceTrajectory(*current_, *a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s));
+    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
     pending_until_s_ = t_eff;
     failed_in_a_row_ = 0;
     holding_ = false;
@@ -366,9 +371,8 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   }
   if (spent || blockedAhead(tau_now)) {
     // Stop where the current trajectory is at the switch, and wait for a route.
-    current_ = std::make_unique<control::SetpointTrajectory>(
-        control::spliceTrajectory(*current_, holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s),
-                                  tau_switch, before_start ? 0.0 : cfg_.blend_s));
+    switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s), tau_switch,
+             before_start ? 0.0 : cfg_.blend_s);
     holding_ = true;
     pending_until_s_ = t_eff;
   }

@@ -120,6 +120,9 @@ class OnlinePlanning {
   bool goalObserved() const;
   bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
   void renewViews(const Attempt& a, double tau_switch);
+  // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
+  // then held within the trajectory's limit (limitYawRate).
+  void switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s);
   control::SetpointTrajectory lookAhead(const control::SetpointTrajectory& trajectory,
                                         const planner::FeatureMap& map) const;
   double tau(double t_s, double trajectory_start_s) const { return tau0_ + (t_s - trajectory_start_s); }

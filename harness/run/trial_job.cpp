@@ -304,7 +304,9 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
   checkOutput(job.out, job.force);
   StagedDir staged(job.out);
   const planner::FeatureMap map =
-      loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial", &options.map_dir);
+      scenario.trial.online.needsSurvey() || !job.map.empty()
+          ? loadSceneFeatureMap(scenario.scene, job.map, job.map_cache, "tgnav trial", &options.map_dir)
+          : planner::FeatureMap(MapBuildConfig{}.resolution_m);
 
   if (job.trial_starting) job.trial_starting();
   const TrialResult r = runTrial(scenario, map, options, progress, interrupt);
