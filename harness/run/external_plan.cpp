@@ -108,6 +108,20 @@ PlanRequestMessage requestFor(const Scenario& scenario, const fs::path& map_dir,
   return m;
 }
 
+// The occupancy slice (and the classes) written into `tmp`, and the request for `scenario`'s start
+// with the map of `map_dir`. Fills out->topo and out->prepare_s.
+PlanRequestMessage prepareRequest(const Scenario& scenario, const fs::path& map_dir, const planner::VoxelMap& voxels,
+                                  std::uint64_t seed, const fs::path& tmp, ExternalPlan* out) {
+  const ExternalPlannerConfig& ext = scenario.planner.external;
+  const auto t0 = Clock::now();
+  const ClearanceBand band = clearanceBand(scenario);
+  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp / "occupancy.yaml", tmp / "occupancy.pgm");
+  if (ext.classes) out->topo = writeClasses(scenario, voxels, seed, tmp / "classes.json");
+  PlanRequestMessage request = requestFor(scenario, map_dir, tmp, seed, ext.classes);
+  out->prepare_s = secondsSince(t0);
+  return request;
+}
+
 // Why a read or write ended without a line, with how the process ended when it did.
 std::string ioFailure(ChildProcess::Io io, ChildProcess* child, double budget_s) {
   switch (io) {
@@ -226,12 +240,7 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const fs::path& map_di
   const ExternalPlannerConfig& ext = scenario.planner.external;
   ExternalPlan out;
   const TempDir tmp;
-  const auto t0 = Clock::now();
-  const ClearanceBand band = clearanceBand(scenario);
-  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp.path() / "occupancy.yaml", tmp.path() / "occupancy.pgm");
-  if (ext.classes) out.topo = writeClasses(scenario, voxels, seed, tmp.path() / "classes.json");
-  const PlanRequestMessage request = requestFor(scenario, map_dir, tmp.path(), seed, ext.classes);
-  out.prepare_s = secondsSince(t0);
+  const PlanRequestMessage request = prepareRequest(scenario, map_dir, voxels, seed, tmp.path(), &out);
 
   PlanResponse response;
   const std::string failure = converse(scenario, request, tmp.path(), interrupt, &out, &response);
@@ -252,8 +261,7 @@ struct ExternalPlannerSession::Impl {
 
 bool ExternalPlannerSession::stopped() const { return !impl_->failure.empty(); }
 
-ExternalPlannerSession::ExternalPlannerSession(const Scenario& scenario)
-    : scenario_(scenario), impl_(std::make_unique<Impl>()) {}
+ExternalPlannerSession::ExternalPlannerSession() : impl_(std::make_unique<Impl>()) {}
 
 ExternalPlannerSession::~ExternalPlannerSession() {
   if (!impl_->child) return;
@@ -261,12 +269,10 @@ ExternalPlannerSession::~ExternalPlannerSession() {
   shutDown(impl_->child.get(), false, &ignored);
 }
 
-ExternalPlan ExternalPlannerSession::ask(const planner::Pose4& start, const planner::FeatureMap& map,
+ExternalPlan ExternalPlannerSession::ask(const Scenario& from_here, const planner::FeatureMap& map,
                                          const planner::VoxelMap& voxels, std::uint64_t seed,
                                          const std::atomic<bool>* interrupt) {
-  const ExternalPlannerConfig& ext = scenario_.planner.external;
-  Scenario from_here = scenario_;
-  from_here.scene.start = start;
+  const ExternalPlannerConfig& ext = from_here.planner.external;
   ExternalPlan out;
   if (stopped()) {
     out.detail = "external planner " + ext.name + ": " + impl_->failure;
@@ -276,12 +282,9 @@ ExternalPlan ExternalPlannerSession::ask(const planner::Pose4& start, const plan
   const auto t0 = Clock::now();
   fs::create_directories(tmp / "map");
   map.save(tmp / "map");
-  const ClearanceBand band = clearanceBand(from_here);
-  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp / "occupancy.yaml", tmp / "occupancy.pgm");
-  if (ext.classes) out.topo = writeClasses(from_here, voxels, seed, tmp / "classes.json");
-  PlanRequestMessage request = requestFor(from_here, tmp / "map", tmp, seed, ext.classes);
+  PlanRequestMessage request = prepareRequest(from_here, tmp / "map", voxels, seed, tmp, &out);
   request.id = impl_->next_id++;
-  out.prepare_s = secondsSince(t0);
+  out.prepare_s = secondsSince(t0);  // the map files included
 
   std::string failure;
   PlanResponse response;

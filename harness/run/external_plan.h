@@ -61,21 +61,21 @@ ExternalPlan askExternalPlanner(const Scenario& scenario, const std::filesystem:
 // crashes or writes garbage is stopped and not asked again (ExternalPlan::stopped).
 class ExternalPlannerSession {
  public:
-  explicit ExternalPlannerSession(const Scenario& scenario);
+  ExternalPlannerSession();
   ~ExternalPlannerSession();
   ExternalPlannerSession(const ExternalPlannerSession&) = delete;
   ExternalPlannerSession& operator=(const ExternalPlannerSession&) = delete;
   ExternalPlannerSession(ExternalPlannerSession&&) = delete;
   ExternalPlannerSession& operator=(ExternalPlannerSession&&) = delete;
 
-  // A route from `start` to the scenario's goal on `map` (`voxels`: buildPlanningVoxels of it).
-  ExternalPlan ask(const planner::Pose4& start, const planner::FeatureMap& map, const planner::VoxelMap& voxels,
+  // A route from `from_here`'s start to its goal (its planner.external) on `map` (`voxels`:
+  // buildPlanningVoxels of it).
+  ExternalPlan ask(const Scenario& from_here, const planner::FeatureMap& map, const planner::VoxelMap& voxels,
                    std::uint64_t seed, const std::atomic<bool>* interrupt = nullptr);
   bool stopped() const;  // it failed: later asks fail at once
 
  private:
   struct Impl;
-  const Scenario& scenario_;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -93,7 +93,7 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
       seed_(seed),
       rrt_samples_(rrt_samples),
       mapper_(onlineMapConfig(survey)),
-      external_(external ? std::make_unique<ExternalPlannerSession>(scenario) : nullptr) {
+      external_(external ? std::make_unique<ExternalPlannerSession>() : nullptr) {
   if (scenario.planner.oracle_class >= 0) {
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +
                      ": an online trial plans again on the map it builds, whose classes change; use trial.mode prior");
@@ -171,7 +171,7 @@ bool OnlinePlanning::askExternal(const Scenario& from_here, const planner::Featu
   a->run.seed = seed_;
   buildPlanningVoxels(from_here, map, &a->run, cfg_.unknown_space == UnknownSpace::kFree);
   a->record.voxel_map_s = a->run.voxel_map_s;
-  ExternalPlan ext = external_->ask(from_here.scene.start, map, *a->run.voxels, seed_);
+  ExternalPlan ext = external_->ask(from_here, map, *a->run.voxels, seed_);
   a->record.solve_s = ext.total_s();
   if (!ext.ok) {
     a->record.detail = ext.detail;
@@ -339,7 +339,9 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   goal_event_ = false;
   const bool must_switch = holding_ || a.record.trigger == "blocked";
   const bool committed = t_s < last_change_s_ + cfg_.commit_s;
-  const bool same = a.trajectory && !before_start && sameRoute(a.run.plan.path, tau_switch);
+  // Whether the plan follows the current route: asked only where it decides something.
+  const bool same = a.trajectory && !before_start && !must_switch && (!committed || cfg_.renew_views) &&
+                    sameRoute(a.run.plan.path, tau_switch);
   if (a.trajectory && !must_switch && (committed || same)) {
     failed_in_a_row_ = 0;
     if (cfg_.renew_views && same) {
