@@ -65,8 +65,9 @@ Camera::Camera(mjModel* m, const EglContext& gl, const CameraConfig& config, std
 }
 
 Camera::~Camera() {
-  gl_.makeCurrent();
-  mjr_freeContext(&context_);
+  // A destructor must not throw: where the context cannot be made current (it could when the
+  // camera was made), its GL objects are left to the context's own destruction.
+  if (gl_.tryMakeCurrent()) mjr_freeContext(&context_);
   mjv_freeScene(&scene_);
 }
 

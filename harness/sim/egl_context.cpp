@@ -75,8 +75,12 @@ EglContext::~EglContext() {
   eglDestroyContext(display_, static_cast<EGLContext>(context_));
 }
 
+bool EglContext::tryMakeCurrent() const noexcept {
+  return eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, static_cast<EGLContext>(context_)) == EGL_TRUE;
+}
+
 void EglContext::makeCurrent() const {
-  if (eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, static_cast<EGLContext>(context_)) != EGL_TRUE) {
+  if (!tryMakeCurrent()) {
     throw InputError(
         "EGL: cannot make the context current (surfaceless contexts need "
         "EGL_KHR_surfaceless_context), error " +

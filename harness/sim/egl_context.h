@@ -18,6 +18,8 @@ class EglContext {
   EglContext& operator=(EglContext&&) = delete;
 
   void makeCurrent() const;
+  // makeCurrent() that reports failure instead of throwing (for destructors).
+  bool tryMakeCurrent() const noexcept;
   // GL_RENDERER of the current context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
   std::string renderer() const;
 
