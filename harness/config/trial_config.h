@@ -86,6 +86,11 @@ struct OnlineConfig {
   // there in view (look before flying there); 0: the planner's yaw everywhere.
   double look_ahead_s = 2.0;
   bool look_ahead_always = false;
+  // With the perception-aware planners (proposed, rrtstar), the turn toward the way ahead goes
+  // only as far as the perception model rates the view trackable on the map the plan was made on
+  // (harness/run/look_ahead.h); false: as far as the way ahead needs, as for agnostic. Off: on
+  // storage and gallery it changed no outcome (README, online planning).
+  bool look_ahead_keeps_tracking = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, then the look-ahead rule on that map. false: the views of the plan last flown.
@@ -107,6 +112,7 @@ struct OnlineConfig {
     a("commit_s", commit_s);
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
+    a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);
     a("renew_views", renew_views);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);

@@ -261,6 +261,8 @@ struct ExternalPlannerSession::Impl {
 
 bool ExternalPlannerSession::stopped() const { return !impl_->failure.empty(); }
 
+std::string ExternalPlannerSession::stderrTail() const { return fileTail(impl_->tmp.path() / "stderr.txt"); }
+
 ExternalPlannerSession::ExternalPlannerSession() : impl_(std::make_unique<Impl>()) {}
 
 ExternalPlannerSession::~ExternalPlannerSession() {

@@ -73,6 +73,8 @@ class ExternalPlannerSession {
   ExternalPlan ask(const Scenario& from_here, const planner::FeatureMap& map, const planner::VoxelMap& voxels,
                    std::uint64_t seed, const std::atomic<bool>* interrupt = nullptr);
   bool stopped() const;  // it failed: later asks fail at once
+  // The last lines the process wrote to stderr so far ("" before it started).
+  std::string stderrTail() const;
 
  private:
   struct Impl;

@@ -4,12 +4,49 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 
 namespace tgnav::harness {
 
 namespace {
-constexpr double kYawWindowS = 1.0;  // the smoothing window
+constexpr double kYawWindowS = 1.0;                 // the smoothing window
+constexpr double kRateEveryS = 0.2;                 // trajectory time between two rated positions
+constexpr double kYawStepRad = 5.0 * M_PI / 180.0;  // between two rated yaws
+// The way half the look-ahead ahead stays this far beyond the way ahead's own limit (half_fov_rad,
+// 10 deg inside the image's edge): 5 deg inside the edge.
+constexpr double kNearMarginRad = 5.0 * M_PI / 180.0;
 }  // namespace
+
+void ViewRater::moveTo(const Eigen::Vector3d& p_WB) {
+  p_WB_ = p_WB;
+  points_ = planner::aggregateSlots(*voxels_, voxels_->visibleSlots(p_WB, *visibility_));
+}
+
+double ViewRater::shortfall(double yaw_rad) const {
+  planner::ViewSupport support;
+  planner::poseInformation(planner::cameraPosition(p_WB_, yaw_rad, *visibility_), yaw_rad, points_, *visibility_,
+                           *information_, &support);
+  return planner::gateShortfall(support, *information_);
+}
+
+double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit) {
+  const double turn = std::remainder(look - planned, 2.0 * M_PI);
+  const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(turn) / kYawStepRad)));
+  double best_share = 1.0;
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = steps; k >= 0; --k) {
+    const double share = static_cast<double>(k) / steps;
+    const double yaw = planned + share * turn;
+    if (k < steps && std::abs(std::remainder(yaw - near, 2.0 * M_PI)) > near_limit) continue;
+    const double shortfall = rater.shortfall(yaw);
+    if (shortfall < best) {
+      best = shortfall;
+      best_share = share;
+    }
+    if (shortfall <= 0.0) break;
+  }
+  return best_share;
+}
 
 void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<control::TrajectorySetpoint>* sp) {
   std::vector<control::TrajectorySetpoint>& s = *sp;
@@ -48,11 +85,13 @@ void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<contro
 
 control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
                                              const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
-                                             bool always, double max_yaw_rate) {
+                                             bool always, double max_yaw_rate, ViewRater* rater) {
   const std::vector<double>& t = trajectory.times();
   std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
   if (look_ahead_s <= 0.0 || t.size() < 3) return trajectory;
   bool changed = false;
+  double rated_at = -std::numeric_limits<double>::infinity();
+  double share = 1.0;  // of the turn toward the way ahead, as last rated
   // The first setpoint keeps its yaw: it is the vehicle's own where the trajectory starts (and the
   // yaw it takes off with); the turn toward the way ahead follows within the rate limit.
   for (std::size_t i = 1; i < sp.size(); ++i) {
@@ -62,8 +101,17 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
     if (way.norm() < 0.1 || (!always && map.isKnown(far) && map.isKnown(near))) continue;
     // The least turn from the planner's yaw that keeps the way ahead in the camera's field of view.
     const double heading = std::atan2(way.y(), way.x());
-    sp[i].yaw_rad =
-        heading + std::clamp(std::remainder(sp[i].yaw_rad - heading, 2.0 * M_PI), -half_fov_rad, half_fov_rad);
+    const double planned = sp[i].yaw_rad;
+    const double look =
+        heading + std::clamp(std::remainder(planned - heading, 2.0 * M_PI), -half_fov_rad, half_fov_rad);
+    if (rater != nullptr && t[i] >= rated_at + kRateEveryS - 1e-9) {
+      rater->moveTo(sp[i].p_WB);
+      const Eigen::Vector2d near_way = (near - sp[i].p_WB).head<2>();
+      const double near_heading = near_way.norm() > 0.05 ? std::atan2(near_way.y(), near_way.x()) : heading;
+      share = trackableShare(*rater, planned, look, near_heading, half_fov_rad + kNearMarginRad);
+      rated_at = t[i];
+    }
+    sp[i].yaw_rad = rater != nullptr ? planned + share * std::remainder(look - planned, 2.0 * M_PI) : look;
     changed = true;
   }
   if (!changed) return trajectory;

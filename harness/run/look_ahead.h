@@ -2,10 +2,13 @@
 // Where the camera looks in an online trial (harness/run/online_planning.h): the look-ahead rule
 // that turns it toward unknown space before the vehicle flies there, within the trajectory's
 // yaw-rate limit.
+#include <Eigen/Core>
 #include <vector>
 
 #include "control/trajectory.h"
 #include "planner/feature_map.h"
+#include "planner/perception.h"
+#include "planner/voxel_map.h"
 
 namespace tgnav::harness {
 
@@ -17,6 +20,36 @@ namespace tgnav::harness {
 // the way ahead (up to pi) was a 1 s swing of up to 5 rad/s (storage, docs/results/online10).
 void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<control::TrajectorySetpoint>* sp);
 
+// Rates views by the planners' perception model on a planner's voxel map (the map a plan was made
+// on): how far a view falls short of being trackable (planner::gateShortfall: 0 where the model,
+// or the gates, rate it trackable; up to 1).
+class ViewRater {
+ public:
+  // All three must outlive the rater.
+  ViewRater(const planner::VoxelMap& voxels, const planner::VisibilityConfig& visibility,
+            const planner::InformationConfig& information)
+      : voxels_(&voxels), visibility_(&visibility), information_(&information) {}
+  // The landmarks a camera with the body at p_WB sees at any yaw (the pose graph's V(p)); the
+  // views asked next are from there.
+  void moveTo(const Eigen::Vector3d& p_WB);
+  // The shortfall of the view along yaw_rad from where moveTo() put the body.
+  double shortfall(double yaw_rad) const;
+
+ private:
+  const planner::VoxelMap* voxels_;
+  const planner::VisibilityConfig* visibility_;
+  const planner::InformationConfig* information_;
+  Eigen::Vector3d p_WB_ = Eigen::Vector3d::Zero();
+  std::vector<planner::WeightedPoint> points_;
+};
+
+// The share (0: `planned`, 1: `look`) of the turn from the planner's yaw to the look-ahead's that
+// the yaw keeps: of the yaws from `look` back to `planned` (5 deg apart) that keep the heading
+// `near` within `near_limit` (the way just ahead stays in the image; `look` itself always may), the
+// first the rater rates trackable from where it is, else the one it rates least short (`look` at a
+// tie).
+double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit);
+
 // Where `trajectory` look_ahead_s ahead (or half that) runs through space `map` has not observed
 // (or everywhere, with `always`), the yaw turns as little as it must from the planner's for the way
 // there to lie within `half_fov_rad` of the camera's axis (the camera looks before the vehicle
@@ -24,9 +57,16 @@ void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<contro
 // way ahead is known, nor where the vehicle hardly moves, nor at the first setpoint (the vehicle's
 // own yaw: a first plan that turned it there turned it during take-off, near the ground, and the VO
 // was lost in the climb on a generated scene that starts facing away from the goal).
+// With `rater` (the perception-aware planners), the turn toward the way ahead goes only as far as
+// keeps the view trackable on the map as it is: every kRateEveryS the yaws from the way ahead back
+// to the planner's are rated, kYawStepRad apart, and the first the rater rates trackable is kept
+// (the least shortfall where none is; the way ahead at a tie, as where nothing is mapped). The
+// first look into unknown space whose walls are bare was blind for every planner, and the VO was
+// lost there (docs/results/online10): the vehicle keeps the mapped texture in view while it turns,
+// and sees the new surfaces at the edge of the image before it looks at them.
 control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
                                              const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
-                                             bool always, double max_yaw_rate);
+                                             bool always, double max_yaw_rate, ViewRater* rater = nullptr);
 
 // `trajectory` with its yaw from time `from_s` on held within `max_rate` of the yaw before it (a
 // forward pass: a faster turn is spread out and followed late, then joins the trajectory's own yaw

@@ -71,6 +71,34 @@ control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double du
   return control::SetpointTrajectory({0.0, duration_s}, {sp, sp});
 }
 
+// Marks free the never-observed voxels of `tree` within `radius_m` (horizontally) of each of
+// `centres`, over the band: where the vehicle has been, and the goal the mission gives, are free
+// whether the camera saw them or not. With unknown_space: blocked the planners see only these and
+// what was observed free; without them the start's own voxels, which the forward camera never
+// sees, left no route from no map (`invalid_start`, then `no_path`).
+void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres, double radius_m,
+              const ClearanceBand& band) {
+  const double res = tree->getResolution();
+  const int n = static_cast<int>(std::ceil(radius_m / res)) + 1;
+  for (const Eigen::Vector3d& c : centres) {
+    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
+      const octomap::OcTreeKey key =
+          tree->coordToKey(static_cast<double>(c.x()), static_cast<double>(c.y()), static_cast<double>(z));
+      for (int i = -n; i <= n; ++i) {
+        for (int j = -n; j <= n; ++j) {
+          octomap::OcTreeKey k = key;
+          k[0] = static_cast<octomap::key_type>(k[0] + i);
+          k[1] = static_cast<octomap::key_type>(k[1] + j);
+          const octomap::point3d v = tree->keyToCoord(k);
+          if (std::hypot(v.x() - c.x(), v.y() - c.y()) > radius_m) continue;
+          if (tree->search(k) == nullptr) tree->updateNode(k, false, /*lazy_eval=*/true);
+        }
+      }
+    }
+  }
+  tree->updateInnerOccupancy();
+}
+
 // How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
 // is looked for when a plan's yaw is carried over to it (OnlinePlanning::renewViews).
 constexpr double kRenewWindowS = 5.0;
@@ -119,11 +147,16 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
 OnlinePlanning::~OnlinePlanning() = default;
 
 control::SetpointTrajectory OnlinePlanning::lookAhead(const control::SetpointTrajectory& trajectory,
-                                                      const planner::FeatureMap& map) const {
+                                                      const planner::FeatureMap& map,
+                                                      const planner::VoxelMap& voxels) const {
+  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
   // The way ahead within the horizontal field of view, 10 deg inside its edge.
-  const double half_fov = std::max(0.0, 0.5 * scenario_.planner.perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+  const double half_fov = std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+  // The perception-aware planners keep their views trackable while they look ahead.
+  const bool keep = cfg_.look_ahead_keeps_tracking && planner_ != planner::PlannerKind::kAgnostic;
+  ViewRater rater(voxels, perception.visibility, perception.information);
   return lookWhereUnknown(trajectory, map, cfg_.look_ahead_s, half_fov, cfg_.look_ahead_always,
-                          scenario_.planner.trajectory.max_yaw_rate_rad_s);
+                          scenario_.planner.trajectory.max_yaw_rate_rad_s, keep ? &rater : nullptr);
 }
 
 OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double t_s, const std::string& trigger) {
@@ -134,6 +167,13 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.record.start = start;
   const auto t0 = std::chrono::steady_clock::now();
   IncrementalMapper::Built built = mapper_.snapshot();
+  visited_.push_back(start.p_WB);
+  if (cfg_.unknown_space == UnknownSpace::kBlocked) {
+    std::vector<Eigen::Vector3d> free = visited_;
+    free.push_back(scenario_.scene.goal.p_WB);
+    markFree(&built.map.occupancy(), free, scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution(),
+             clearanceBand(scenario_));
+  }
   a.record.snapshot_s = secondsSince(t0);
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   Scenario from_here = scenario_;
@@ -161,7 +201,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
     a.record.path_unknown.push_back(!built.map.isKnown(p.p_WB));
   }
   // An external planner's yaw is its own: the look-ahead rule is the built-in planners'.
-  a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map);
+  a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map, *a.run.voxels);
   a.map = std::move(built.map);
   return a;
 }
@@ -289,7 +329,7 @@ void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   }
   if (tt.size() < 3) return;
   smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
-  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map), tau_switch, cfg_.blend_s);
+  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
@@ -398,6 +438,7 @@ const OnlinePlan* planAt(const std::vector<OnlinePlan>& plans, double t_s) {
 OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,
                                     const std::vector<std::pair<double, Eigen::Vector3d>>& flown) {
   OnlineResult out = std::move(result_);
+  if (external_) out.planner_stderr = external_->stderrTail();
   out.final_map = mapper_.snapshot().map;
   const octomap::OcTree& tree = out.final_map->occupancy();
   const double res = tree.getResolution();

@@ -64,11 +64,12 @@ struct OnlineResult {
   int keyframes = 0;          // frames mapped
   double map_update_s = 0.0;  // wall clock of all map updates
   std::optional<planner::FeatureMap> final_map;
-  double coverage = 0.0;             // share of the flight band's voxels in the scene bounds observed
-  int occupied_voxels = 0;           // in the final map, inside the bounds widened by 0.5 m
-  double map_error_mean_m = 0.0;     // their centres' mean distance to the true geometry
-  double map_error_far_share = 0.0;  // ... share farther than two voxels from it
-  double unknown_share = 0.0;        // of the flown trajectory: in space unknown when planned
+  double coverage = 0.0;                      // share of the flight band's voxels in the scene bounds observed
+  int occupied_voxels = 0;                    // in the final map, inside the bounds widened by 0.5 m
+  double map_error_mean_m = 0.0;              // their centres' mean distance to the true geometry
+  double map_error_far_share = 0.0;           // ... share farther than two voxels from it
+  double unknown_share = 0.0;                 // of the flown trajectory: in space unknown when planned
+  std::optional<std::string> planner_stderr;  // an external planner's: the last lines it wrote to stderr
 };
 
 class OnlinePlanning {
@@ -123,8 +124,9 @@ class OnlinePlanning {
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
   // then held within the trajectory's limit (limitYawRate).
   void switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s);
-  control::SetpointTrajectory lookAhead(const control::SetpointTrajectory& trajectory,
-                                        const planner::FeatureMap& map) const;
+  // The look-ahead rule on `trajectory`, planned on `map` (and `voxels`, its planners' voxel map).
+  control::SetpointTrajectory lookAhead(const control::SetpointTrajectory& trajectory, const planner::FeatureMap& map,
+                                        const planner::VoxelMap& voxels) const;
   double tau(double t_s, double trajectory_start_s) const { return tau0_ + (t_s - trajectory_start_s); }
 
   const Scenario& scenario_;
@@ -141,10 +143,11 @@ class OnlinePlanning {
   double pending_until_s_ = -1.0;  // a plan takes effect then; none is asked before
   double last_change_s_ = -1e9;    // when the last plan that changed the route was asked
   bool blocked_ = false;
-  bool goal_seen_ = false;   // the goal's voxel has been observed
-  bool goal_event_ = false;  // ... by the last keyframe: a plan is due
-  bool holding_ = false;     // flying a hold: no route
-  int failed_in_a_row_ = 0;  // plans without a route since the last one with
+  bool goal_seen_ = false;                // the goal's voxel has been observed
+  bool goal_event_ = false;               // ... by the last keyframe: a plan is due
+  bool holding_ = false;                  // flying a hold: no route
+  int failed_in_a_row_ = 0;               // plans without a route since the last one with
+  std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   OnlineResult result_;
 };
 

@@ -238,7 +238,11 @@ void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& 
                                            ") --seed " + std::to_string(options.seed) + "\n" +
                                            resolvedScenarioYaml(scenario));
     writeFileAtomic(d / "plan.json", externalPlanJson(scenario, options, r).dump(2) + "\n");
-    writeFileAtomic(d / "planner_stderr.txt", r.external ? r.external->stderr_tail : std::string());
+    // Online, the session's (it was asked at every plan); else the single ask's.
+    const std::optional<std::string>& online_tail = r.online ? r.online->planner_stderr : std::nullopt;
+    writeFileAtomic(d / "planner_stderr.txt", online_tail  ? *online_tail
+                                              : r.external ? r.external->stderr_tail
+                                                           : std::string());
   } else {
     writeFileAtomic(d / "config.yaml", runConfigYaml("trial", scenario, r.plan));
     writeFileAtomic(d / "plan.json", planJson(scenario, r.plan).dump(2) + "\n");

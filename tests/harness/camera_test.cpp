@@ -199,7 +199,9 @@ TEST(CameraNoiseTest, QuantilesAreTheStandardNormals) {
   ASSERT_EQ(z.size(), 65536u);
   double mean = 0.0, var = 0.0;
   for (std::size_t i = 0; i < z.size(); ++i) {
-    if (i > 0) ASSERT_LT(z[i - 1], z[i]) << i;
+    if (i > 0) {
+      ASSERT_LT(z[i - 1], z[i]) << i;
+    }
     ASSERT_EQ(z[i], -z[z.size() - 1 - i]);
     const double p = (static_cast<double>(i) + 0.5) / 65536.0;
     ASSERT_NEAR(0.5 * std::erfc(-z[i] / std::sqrt(2.0)), p, 1e-7 + 1e-6 * p) << i;

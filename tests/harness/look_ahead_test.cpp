@@ -1,10 +1,16 @@
 // The camera's yaw in an online trial (harness/run/look_ahead.h): smoothing within a yaw-rate
-// limit that keeps the first yaw, and the rate limit applied to a spliced trajectory.
+// limit that keeps the first yaw, the rate limit applied to a spliced trajectory, and the turn
+// toward the way ahead that keeps the view trackable.
 #include "harness/run/look_ahead.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
+
+#include "planner/feature_map.h"
+#include "planner/perception.h"
+#include "planner/voxel_map.h"
 
 namespace tgnav::harness {
 namespace {
@@ -64,6 +70,84 @@ TEST(LimitYawRate, HoldsTheLimitFromTheSwitchOnAndRejoinsTheYaw) {
   // Within the limit, nothing changes at all.
   const control::SetpointTrajectory slow = spinning(5.0, [](double t) { return 0.5 * t; });
   EXPECT_EQ(limitYawRate(slow, 0.0, 0.6).setpoints().back().yaw_rad, slow.setpoints().back().yaw_rad);
+}
+
+// A textured wall facing west at x = 3.5 (y in [-1.5, 1], z in [0.5, 1.5]), two landmarks on each
+// voxel of its face, each detected whenever in view; nothing else is known.
+planner::FeatureMap texturedWall() {
+  planner::FeatureMap map(0.1);
+  std::vector<planner::Landmark> landmarks;
+  for (double y = -1.45; y < 1.0; y += 0.1) {
+    for (double z = 0.55; z < 1.5; z += 0.1) {
+      map.occupancy().updateNode(octomap::point3d(3.55F, static_cast<float>(y), static_cast<float>(z)), true);
+      for (double dz : {-0.02, 0.02}) {
+        planner::Landmark lm;
+        lm.p_W = Eigen::Vector3d(3.5, y, z + dz);
+        lm.observations = lm.opportunities = 1;
+        lm.ref_kf_p_W = Eigen::Vector3d(0.0, y, z);
+        landmarks.push_back(lm);
+      }
+    }
+  }
+  map.setLandmarks(landmarks);
+  EXPECT_EQ(map.embedLandmarks(0.15), 0);
+  return map;
+}
+
+constexpr double kDeg = M_PI / 180.0;
+
+TEST(LookAhead, KeepsTheViewTrackableAsFarTowardTheWayAheadAsItMay) {
+  const planner::FeatureMap map = texturedWall();
+  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
+  const planner::VisibilityConfig visibility;
+  planner::InformationConfig information;  // the gates: 50 detections, a fifth of the image
+  ViewRater rater(voxels, visibility, information);
+  rater.moveTo(Eigen::Vector3d(1.75, 0.0, 1.0));
+  // The planner looks at the wall; the way ahead turns north, where nothing is known.
+  const double planned = 0.0;
+  const double look = 60.0 * kDeg;
+  ASSERT_EQ(rater.shortfall(planned), 0.0);
+  ASSERT_GT(rater.shortfall(look), 0.0);
+  // The turn stops at the first yaw from the way ahead back that keeps the wall trackable.
+  const double share = trackableShare(rater, planned, look, look, M_PI);
+  ASSERT_GT(share, 0.0);
+  ASSERT_LT(share, 1.0);
+  const double kept = planned + share * look;
+  EXPECT_EQ(rater.shortfall(kept), 0.0);
+  EXPECT_GT(rater.shortfall(kept + 5.0 * kDeg), 0.0);
+  std::cout << "[ figure   ] the view keeps the wall at " << kept / kDeg << " deg (way ahead: 60)\n";
+  // A view of the way ahead that is trackable is kept as it is.
+  EXPECT_EQ(trackableShare(rater, planned, 10.0 * kDeg, 10.0 * kDeg, M_PI), 1.0);
+  // The way just ahead stays in the image: where it lies at 90 deg within 35, no yaw that keeps it
+  // sees enough of the wall; the least short of them is kept, within the limit.
+  const double limited = planned + trackableShare(rater, planned, look, 90.0 * kDeg, 35.0 * kDeg) * look;
+  EXPECT_GE(limited, 55.0 * kDeg - 1e-9);
+}
+
+TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
+  // East along y = 0 toward the wall, the planner looking south: the look-ahead turns the camera
+  // east, where the wall is in view and trackable, and the rater changes nothing.
+  const planner::FeatureMap map = texturedWall();
+  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
+  const planner::VisibilityConfig visibility;
+  const planner::InformationConfig information;
+  ViewRater rater(voxels, visibility, information);
+  std::vector<double> t;
+  std::vector<control::TrajectorySetpoint> sp;
+  for (int i = 0; i <= 600; ++i) {
+    t.push_back(i * 0.01);
+    control::TrajectorySetpoint s;
+    s.p_WB = Eigen::Vector3d(1.5 + 0.2 * i * 0.01, 0.0, 1.0);
+    s.yaw_rad = -80.0 * kDeg;
+    sp.push_back(s);
+  }
+  const control::SetpointTrajectory east(t, sp);
+  const control::SetpointTrajectory plain = lookWhereUnknown(east, map, 2.0, 27.6 * kDeg, false, 0.6);
+  const control::SetpointTrajectory rated = lookWhereUnknown(east, map, 2.0, 27.6 * kDeg, false, 0.6, &rater);
+  for (double at : {1.0, 3.0, 5.0}) {
+    EXPECT_GT(plain.sample(at).yaw_rad, -60.0 * kDeg);  // turned toward the way ahead
+    EXPECT_DOUBLE_EQ(rated.sample(at).yaw_rad, plain.sample(at).yaw_rad);
+  }
 }
 
 }  // namespace

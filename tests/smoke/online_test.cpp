@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -127,6 +128,10 @@ TEST(OnlineTrial, ARadiusPriorKeepsTheSurveyNearTheStartOnly) {
   EXPECT_GT(first("near"), 0);
   EXPECT_LT(first("near"), first("survey") / 2);
   EXPECT_EQ(first("all"), first("survey"));  // a radius beyond the scene keeps it all
+  // From no map with unknown space blocked, the vehicle's own place and the goal are free: the
+  // first plan finds no known route (the space between is unseen), not an invalid start.
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.unknown_space=blocked --out " + (dir / "blocked").string())).rc, 0);
+  EXPECT_EQ(readJson(dir / "blocked/online.json")["plans"][0]["detail"], "no path: no_path");
   EXPECT_EQ(readJson(dir / "near/metrics.json")["online"]["prior_map"], "radius");
 }
 
@@ -158,6 +163,7 @@ TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
                           "        break\n"
                           "    n += 1\n"
                           "    if n == 2:\n"
+                          "        print('giving up after', n - 1, 'plans', file=sys.stderr, flush=True)\n"
                           "        sys.exit(7)\n"
                           "    print(json.dumps({'protocol': 'tgnav-planner', 'version': 1, 'id': req['id'],\n"
                           "                      'status': 'no_path', 'reason': 'not yet'}), flush=True)\n";
@@ -171,6 +177,10 @@ TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
       << q["detail"];
   const nlohmann::json first = readJson(dir / "quits/online.json")["plans"][0];
   EXPECT_EQ(first["detail"], "external planner quits: no path: not yet");
+  // What it wrote to stderr over the flight is kept, as for a planner asked once.
+  std::ifstream err(dir / "quits/planner_stderr.txt");
+  const std::string tail((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  EXPECT_NE(tail.find("giving up after 1 plans"), std::string::npos) << tail;
 }
 
 TEST(OnlineTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
