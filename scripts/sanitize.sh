@@ -152,6 +152,15 @@ case "$mode" in
     # And the report's figures (48 s here, nearly all of it matplotlib, which the sanitizers do not
     # see): the report of the smoke sweep below draws them through the same code.
     slow+='|ReportCommand\.DrawsTheFigures'
+    # And five more (145 s of 846 s of test time here; CI on 2 cores had run past its 45 minutes),
+    # each beside smaller tests of the same code that run here: the topological planner's random
+    # maps (every planner test plans through it), RRT*'s seeded repeats (its other route tests), the
+    # detour scene's route check (every kind, detour included, is generated and compiled by
+    # SceneGenerator.EveryKind...), scene A of the Table I scenes (scenes B and C), and the
+    # proposed planner's sameness across thread counts (a check of determinism, not of memory).
+    slow+='|TopologicalPlanner\.ShortestClassIsNearOptimalOnRandomMaps|PerceptionRrtStar\.SeededRunsRepeat'
+    slow+='|SceneGenerator\.DetourKeepsTheShortestRouteBlind|PerceptionPlanner\.SceneATexturedClassTwentyPercentLonger'
+    slow+='|PerceptionPlanner\.SameSeedSamePlanWhateverTheThreadCount'
     # A test that runs tgnav may meet the random tracer crash at the process's exit (lsan_retry):
     # when that is all that failed, the failed tests run once more.
     ctest_log=$(mktemp)
