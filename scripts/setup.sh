@@ -30,6 +30,7 @@ step() {
 
 packages=(
   g++ cmake make pkg-config
+  ninja-build                         # the sanitizer build (scripts/sanitize.sh: its targets in parallel)
   lld                                 # the linker (CMakeLists.txt: links about 5 times faster than ld.bfd)
   libmujoco-dev libqhull-dev          # MuJoCo 2.2 (its CMake target names qhull's include dir)
   libegl-dev libegl-mesa0 libgl-dev libgl1-mesa-dri   # headless EGL, llvmpipe software GL
