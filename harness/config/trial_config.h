@@ -91,6 +91,11 @@ struct OnlineConfig {
   // (harness/run/look_ahead.h); false: as far as the way ahead needs, as for agnostic. Off: on
   // storage and gallery it changed no outcome (README, online planning).
   bool look_ahead_keeps_tracking = false;
+  // The built-in planners' trajectories end at rest before their path first comes within the robot
+  // radius and two voxels of space unknown when planned (0.5 m on at least), the camera turned to
+  // see the way on; the next plan, made once the map has grown, sends the vehicle on
+  // (harness/run/look_ahead.h, stopBeforeUnknown).
+  bool stop_before_unknown = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, then the look-ahead rule on that map. false: the views of the plan last flown.
@@ -113,6 +118,7 @@ struct OnlineConfig {
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
     a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);
+    a("stop_before_unknown", stop_before_unknown);
     a("renew_views", renew_views);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);

@@ -235,4 +235,19 @@ IncrementalMapper::Built IncrementalMapper::snapshot() const {
 
 IncrementalMapper::Built IncrementalMapper::release() { return build(std::move(tree_)); }
 
+octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m) {
+  const double res = tree.getResolution();
+  octomap::OcTree out(res);
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
+      if ((p - centre).head<2>().norm() > radius_m) return;
+      out.setNodeValue(
+          octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
+          it->getLogOdds(), /*lazy_eval=*/true);
+    });
+  }
+  out.updateInnerOccupancy();
+  return out;
+}
+
 }  // namespace tgnav::harness

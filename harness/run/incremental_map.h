@@ -6,6 +6,9 @@
 // camera's keyframes at the pose it maps at, and takes a snapshot whenever it plans.
 #include <octomap/OcTree.h>
 
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -16,6 +19,24 @@
 #include "vo/features.h"
 
 namespace tgnav::harness {
+
+// Calls fn(p) with the centre of every map voxel that the leaf at `it` covers (a leaf may be a
+// merged cube of many voxels).
+template <typename LeafIterator, typename Fn>
+void forEachVoxel(const LeafIterator& it, double res, const Fn& fn) {
+  const int n = std::max(1, static_cast<int>(std::lround(it.getSize() / res)));
+  const Eigen::Vector3d corner =
+      Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * it.getSize() - 0.5 * res);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      for (int k = 0; k < n; ++k) fn(Eigen::Vector3d(corner + res * Eigen::Vector3d(i, j, k)));
+    }
+  }
+}
+
+// The occupancy of `tree` within `radius_m` (horizontally) of `centre`, voxel by voxel (an online
+// trial's prior of the survey near the start).
+octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m);
 
 class IncrementalMapper {
  public:

@@ -119,6 +119,62 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
   return control::SetpointTrajectory(t, std::move(sp));
 }
 
+namespace {
+
+// Whether p's voxel of `map`, and every one within clear_m of p (horizontally, at p's height), is
+// observed or lies within visited_m of a place the vehicle has been.
+bool observedAround(const Eigen::Vector3d& p, const planner::FeatureMap& map,
+                    const std::vector<Eigen::Vector3d>& visited, double clear_m, double visited_m) {
+  const double res = map.resolution();
+  const int n = static_cast<int>(std::ceil(clear_m / res));
+  const octomap::OcTree& tree = map.occupancy();
+  const octomap::point3d c = tree.keyToCoord(tree.coordToKey(
+      octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()))));
+  const Eigen::Vector3d centre(c.x(), c.y(), c.z());
+  for (int i = -n; i <= n; ++i) {
+    for (int j = -n; j <= n; ++j) {
+      const Eigen::Vector3d v = centre + res * Eigen::Vector3d(i, j, 0.0);
+      if ((i != 0 || j != 0) && (v - p).head<2>().norm() > clear_m) continue;
+      if (map.isKnown(v)) continue;
+      const bool been = std::any_of(visited.begin(), visited.end(),
+                                    [&](const Eigen::Vector3d& q) { return (v - q).head<2>().norm() <= visited_m; });
+      if (!been) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<planner::Pose4> stopBeforeUnknown(const std::vector<planner::Pose4>& path, const planner::FeatureMap& map,
+                                              const std::vector<Eigen::Vector3d>& visited, const StopRule& rule) {
+  std::vector<double> s(path.size(), 0.0);  // along the path
+  for (std::size_t i = 1; i < path.size(); ++i) s[i] = s[i - 1] + (path[i].p_WB - path[i - 1].p_WB).norm();
+  // The first point the vehicle may not fly to: its own voxel unobserved (and not where the vehicle
+  // has been), or, beyond min_m along, any voxel within clear_m.
+  std::size_t stop = path.size();
+  for (std::size_t i = 1; i < path.size() && stop == path.size(); ++i) {
+    const bool open = observedAround(path[i].p_WB, map, visited, 0.0, rule.clear_m);
+    if (!open || (s[i] > rule.min_m && !observedAround(path[i].p_WB, map, visited, rule.clear_m, rule.clear_m))) {
+      stop = i;
+    }
+  }
+  if (stop == path.size()) return path;
+  const std::size_t end = stop - 1;
+  std::vector<planner::Pose4> out(path.begin(), path.begin() + static_cast<std::ptrdiff_t>(end) + 1);
+  // The way on: the path's point look_m beyond the end (its last where it is shorter).
+  std::size_t on = end + 1;
+  while (on + 1 < path.size() && s[on] < s[end] + rule.look_m) ++on;
+  const Eigen::Vector2d d = (path[on].p_WB - path[end].p_WB).head<2>();
+  if (d.norm() > 1e-6) {
+    const double heading = std::atan2(d.y(), d.x());
+    double& yaw = out.back().yaw_rad;
+    const double off = std::remainder(heading - yaw, 2.0 * M_PI);
+    if (std::abs(off) > rule.half_fov_rad) yaw = heading - std::copysign(rule.half_fov_rad, off);
+  }
+  return out;
+}
+
 control::SetpointTrajectory limitYawRate(const control::SetpointTrajectory& trajectory, double from_s,
                                          double max_rate) {
   const std::vector<double>& t = trajectory.times();

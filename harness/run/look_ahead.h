@@ -8,6 +8,7 @@
 #include "control/trajectory.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
+#include "planner/pose4.h"
 #include "planner/voxel_map.h"
 
 namespace tgnav::harness {
@@ -67,6 +68,27 @@ double trackableShare(const ViewRater& rater, double planned, double look, doubl
 control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
                                              const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
                                              bool always, double max_yaw_rate, ViewRater* rater = nullptr);
+
+// Where a trajectory stops short of unknown space (trial.stop_before_unknown).
+struct StopRule {
+  // A point of the path is observed where every voxel within clear_m of it (horizontally, at its
+  // height) is, or lies within clear_m of a place the vehicle has been (`visited`: the forward
+  // camera never sees the vehicle's own place).
+  double clear_m = 0.5;
+  double min_m = 0.5;          // ... beyond this far along the path (its own voxels: everywhere)
+  double look_m = 1.0;         // the way on: the path this far beyond where it stops
+  double half_fov_rad = 0.48;  // ... kept this close to the camera's axis at the stop
+};
+
+// The part of `path` (a plan from where the vehicle is) that ends before it first runs into space
+// `map` has not observed: up to the point before the first whose own voxel is unobserved, or,
+// beyond rule.min_m along, any voxel within rule.clear_m; voxels within rule.clear_m of a visited
+// place count as observed. The last point's yaw turns from the planner's as little as keeps the
+// way on within rule.half_fov_rad of the camera's axis: at rest there the camera sees where the
+// path goes (and what lies beside it) before the next plan sends the vehicle on. The whole path
+// where it stays in observed space; the start alone, turned, where its next point is unobserved.
+std::vector<planner::Pose4> stopBeforeUnknown(const std::vector<planner::Pose4>& path, const planner::FeatureMap& map,
+                                              const std::vector<Eigen::Vector3d>& visited, const StopRule& rule);
 
 // `trajectory` with its yaw from time `from_s` on held within `max_rate` of the yaw before it (a
 // forward pass: a faster turn is spread out and followed late, then joins the trajectory's own yaw

@@ -33,34 +33,9 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   return config;
 }
 
-// Calls fn(p) with the centre of every map voxel that the leaf at `it` covers (a leaf may be a
-// merged cube of many voxels).
-template <typename LeafIterator, typename Fn>
-void forEachVoxel(const LeafIterator& it, double res, const Fn& fn) {
-  const int n = std::max(1, static_cast<int>(std::lround(it.getSize() / res)));
-  const Eigen::Vector3d corner =
-      Eigen::Vector3d(it.getX(), it.getY(), it.getZ()) - Eigen::Vector3d::Constant(0.5 * it.getSize() - 0.5 * res);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      for (int k = 0; k < n; ++k) fn(Eigen::Vector3d(corner + res * Eigen::Vector3d(i, j, k)));
-    }
-  }
-}
-
-// The survey's occupancy within `radius_m` (horizontally) of `centre`, voxel by voxel.
-octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m) {
-  const double res = tree.getResolution();
-  octomap::OcTree out(res);
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
-      if ((p - centre).head<2>().norm() > radius_m) return;
-      out.setNodeValue(
-          octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
-          it->getLogOdds(), /*lazy_eval=*/true);
-    });
-  }
-  out.updateInnerOccupancy();
-  return out;
+// The look-ahead keeps the way ahead within the horizontal field of view, 10 deg inside its edge.
+double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception) {
+  return std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
 }
 
 // A trajectory that holds `pose` for `duration_s` (a vehicle without a route waits for one).
@@ -102,6 +77,9 @@ void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres
 // How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
 // is looked for when a plan's yaw is carried over to it (OnlinePlanning::renewViews).
 constexpr double kRenewWindowS = 5.0;
+// trial.stop_before_unknown: look_ahead.h's StopRule::min_m and look_m.
+constexpr double kStopMinM = 0.5;
+constexpr double kStopLookM = 1.0;
 
 }  // namespace
 
@@ -111,6 +89,7 @@ struct OnlinePlanning::Attempt {
   std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
   std::optional<control::SetpointTrajectory> raw;         // the planner's
   std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
+  bool stops_short = false;  // its trajectory ends before the path does (stop_before_unknown)
 };
 
 OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey,
@@ -150,8 +129,7 @@ control::SetpointTrajectory OnlinePlanning::lookAhead(const control::SetpointTra
                                                       const planner::FeatureMap& map,
                                                       const planner::VoxelMap& voxels) const {
   const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
-  // The way ahead within the horizontal field of view, 10 deg inside its edge.
-  const double half_fov = std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+  const double half_fov = lookAheadHalfFov(perception);
   // The perception-aware planners keep their views trackable while they look ahead.
   const bool keep = cfg_.look_ahead_keeps_tracking && planner_ != planner::PlannerKind::kAgnostic;
   ViewRater rater(voxels, perception.visibility, perception.information);
@@ -168,11 +146,11 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   const auto t0 = std::chrono::steady_clock::now();
   IncrementalMapper::Built built = mapper_.snapshot();
   visited_.push_back(start.p_WB);
+  const double clear_m = scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution();
   if (cfg_.unknown_space == UnknownSpace::kBlocked) {
     std::vector<Eigen::Vector3d> free = visited_;
     free.push_back(scenario_.scene.goal.p_WB);
-    markFree(&built.map.occupancy(), free, scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution(),
-             clearanceBand(scenario_));
+    markFree(&built.map.occupancy(), free, clear_m, clearanceBand(scenario_));
   }
   a.record.snapshot_s = secondsSince(t0);
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
@@ -199,6 +177,28 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   for (const planner::Pose4& p : a.run.plan.path) {
     a.record.path.push_back(p.p_WB);
     a.record.path_unknown.push_back(!built.map.isKnown(p.p_WB));
+  }
+  if (cfg_.stop_before_unknown && !external_) {
+    // Observed: the robot radius and two voxels around the path (as the free places of `blocked`).
+    const StopRule rule{clear_m, kStopMinM, kStopLookM, lookAheadHalfFov(scenario_.planner.perception)};
+    std::vector<planner::Pose4> part = stopBeforeUnknown(a.run.plan.path, built.map, visited_, rule);
+    if (part.size() < a.run.plan.path.size()) {
+      // The path flown from here on (the record keeps the plan's whole path).
+      a.run.plan.path = std::move(part);
+      a.stops_short = true;
+      if (a.run.plan.path.size() < 2) {  // nowhere to go yet: turn where it is to see the way on
+        a.raw = holdTrajectory(a.run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s);
+      } else {
+        smoothPath(from_here, a.run.plan.path, nullptr, &a.run);
+        a.record.trajectory_s += a.run.trajectory_s;
+        if (!a.run.trajectory.trajectory) {
+          a.record.ok = false;
+          a.record.detail = "trajectory generation failed: " + a.run.trajectory.reason;
+          return a;
+        }
+        a.raw = setpoints(a.run, rate_hz);
+      }
+    }
   }
   // An external planner's yaw is its own: the look-ahead rule is the built-in planners'.
   a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map, *a.run.voxels);
@@ -254,6 +254,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   next_replan_s_ = cfg_.replan_period_s;
   if (a.trajectory) {
     a.record.adopted = true;
+    stops_short_ = a.stops_short;
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
   } else {
@@ -377,7 +378,10 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   next_replan_s_ = t_s + cfg_.replan_period_s;
   blocked_ = false;
   goal_event_ = false;
-  const bool must_switch = holding_ || a.record.trigger == "blocked";
+  // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
+  // to this one.
+  const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
+  const bool must_switch = holding_ || stopping || a.record.trigger == "blocked";
   const bool committed = t_s < last_change_s_ + cfg_.commit_s;
   // Whether the plan follows the current route: asked only where it decides something.
   const bool same = a.trajectory && !before_start && !must_switch && (!committed || cfg_.renew_views) &&
@@ -394,6 +398,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   }
   if (a.trajectory) {
     a.record.adopted = true;
+    stops_short_ = a.stops_short;
     last_change_s_ = t_s;
     switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
     pending_until_s_ = t_eff;

@@ -146,6 +146,7 @@ class OnlinePlanning {
   bool goal_seen_ = false;                // the goal's voxel has been observed
   bool goal_event_ = false;               // ... by the last keyframe: a plan is due
   bool holding_ = false;                  // flying a hold: no route
+  bool stops_short_ = false;              // the trajectory flown stops short of unknown space
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   OnlineResult result_;

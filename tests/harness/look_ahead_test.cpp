@@ -150,5 +150,65 @@ TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
   }
 }
 
+TEST(StopBeforeUnknown, EndsBeforeThePathComesNearUnobservedSpaceAndLooksAtTheWayOn) {
+  // A path along voxel centres east along y = 0.05 from x = 0.05 to 5.95, then north to y = 3.05;
+  // observed free: a band y in [-0.3, 0.3) from x = 0.3 to 3.0, but for a hole at x in [1.4, 1.7).
+  // The vehicle started at the path's start (its own place, which the forward camera never sees).
+  planner::FeatureMap map(0.1);
+  const auto observe = [&](int from, int to) {  // the voxels x in [0.1 from, 0.1 to) of the band
+    for (int k = from; k < to; ++k) {
+      for (int j = -3; j < 3; ++j) {
+        map.occupancy().updateNode(
+            octomap::point3d(static_cast<float>(0.1 * k + 0.05), static_cast<float>(0.1 * j + 0.05), 1.05F), false);
+      }
+    }
+  };
+  observe(3, 14);
+  observe(17, 30);
+  std::vector<planner::Pose4> path;
+  for (int i = 0; i < 60; ++i) path.push_back(planner::Pose4{Eigen::Vector3d(0.1 * i + 0.05, 0.05, 1.05), 0.0});
+  for (int k = 1; k <= 30; ++k) path.push_back(planner::Pose4{Eigen::Vector3d(5.95, 0.1 * k + 0.05, 1.05), M_PI / 2});
+  const Eigen::Vector3d start = path.front().p_WB;
+  const Eigen::Vector3d hole(1.55, 0.05, 1.05);
+  // Within 0.25 m of the path (beyond 0.45 m on; the points lie 0.1 m apart): the hole stops it
+  // at x = 1.15, whose voxels within 0.25 m reach x = 1.35 ...
+  StopRule rule{0.25, 0.45, 0.95, 30.0 * kDeg};
+  std::vector<planner::Pose4> part = stopBeforeUnknown(path, map, {start}, rule);
+  ASSERT_EQ(part.size(), 12U);
+  EXPECT_NEAR(part.back().p_WB.x(), 1.15, 1e-9);
+  // ... unless the vehicle has been there; then it goes on to x = 2.75, where the way on lies
+  // straight ahead and the planner's yaw stays.
+  part = stopBeforeUnknown(path, map, {start, hole}, rule);
+  ASSERT_EQ(part.size(), 28U);
+  EXPECT_NEAR(part.back().p_WB.x(), 2.75, 1e-9);
+  EXPECT_DOUBLE_EQ(part.back().yaw_rad, 0.0);
+  // Observed up to the corner's x = 6.0: it stops at x = 5.75, where the way on turns north, and
+  // the camera turns as little as keeps it within 30 deg of its axis.
+  observe(14, 17);
+  observe(30, 60);
+  part = stopBeforeUnknown(path, map, {start}, rule);
+  ASSERT_EQ(part.size(), 58U);
+  EXPECT_NEAR(part.back().p_WB.x(), 5.75, 1e-9);
+  const double heading = std::atan2(0.8, 0.2);  // to (5.95, 0.85), 0.95 m on along the path
+  EXPECT_NEAR(part.back().yaw_rad, heading - 30.0 * kDeg, 1e-9);
+  EXPECT_DOUBLE_EQ(part[56].yaw_rad, 0.0);  // only the last point turns
+  // Where nothing is observed, it goes only as far as the vehicle's own place reaches (0.25 m),
+  // and without even that, nowhere: the start alone, its yaw turned to see the way on.
+  const planner::FeatureMap empty(0.1);
+  part = stopBeforeUnknown(path, empty, {start}, rule);
+  ASSERT_EQ(part.size(), 3U);
+  EXPECT_NEAR(part.back().p_WB.x(), 0.25, 1e-9);
+  const std::vector<planner::Pose4> north = {path[0], planner::Pose4{Eigen::Vector3d(0.05, 1.05, 1.05), 0.0}};
+  part = stopBeforeUnknown(north, empty, {}, rule);
+  ASSERT_EQ(part.size(), 1U);
+  EXPECT_NEAR(part.back().yaw_rad, M_PI / 2 - 30.0 * kDeg, 1e-9);
+  // A path in observed space is kept whole, and so is one within 0.45 m whose own voxels are
+  // observed.
+  const std::vector<planner::Pose4> short_path(path.begin(), path.begin() + 21);
+  EXPECT_EQ(stopBeforeUnknown(short_path, map, {start}, rule).size(), 21U);
+  const std::vector<planner::Pose4> near_end(path.begin(), path.begin() + 5);
+  EXPECT_EQ(stopBeforeUnknown(near_end, map, {start}, rule).size(), 5U);
+}
+
 }  // namespace
 }  // namespace tgnav::harness

@@ -135,6 +135,25 @@ TEST(OnlineTrial, ARadiusPriorKeepsTheSurveyNearTheStartOnly) {
   EXPECT_EQ(readJson(dir / "near/metrics.json")["online"]["prior_map"], "radius");
 }
 
+TEST(OnlineTrial, StoppingBeforeUnknownSpaceShortensTheFirstTrajectoryFromNoMap) {
+  // Short flights: the first plan from no map runs straight to the goal through space not yet
+  // seen. With trial.stop_before_unknown nothing is observed at take-off, so its trajectory goes
+  // only as far as the vehicle's own place (the robot radius and two voxels: 0.5 m) and stops.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall + " --set trial.max_flight_s=1";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "on").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.stop_before_unknown=true --out " + (dir / "stop").string())).rc, 0);
+  const nlohmann::json on = readJson(dir / "on/metrics.json");
+  const nlohmann::json stop = readJson(dir / "stop/metrics.json");
+  std::cout << "[ figure   ] first trajectory: " << on["trajectory_length_m"] << " m of a " << on["planned_length_m"]
+            << " m path; stopping before unknown space: " << stop["trajectory_length_m"] << " m\n";
+  EXPECT_EQ(stop["planned_length_m"], on["planned_length_m"]);  // the same plan
+  EXPECT_NEAR(on["trajectory_length_m"].get<double>(), on["planned_length_m"].get<double>(), 0.5);
+  EXPECT_GT(stop["trajectory_length_m"].get<double>(), 0.1);
+  EXPECT_LE(stop["trajectory_length_m"].get<double>(), 0.5);
+  EXPECT_TRUE(readJson(dir / "stop/online.json")["plans"][0]["adopted"].get<bool>());
+}
+
 TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
   const auto dir = test::tempDir();
   // The example A* planner behind a guard that makes a second start of the command fail.
