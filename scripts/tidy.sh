@@ -11,7 +11,8 @@
 #                              a batch are checked as its headers are (their findings name them).
 #                              Every source still compiles on its own in the normal build (build/).
 #   scripts/tidy.sh FILE...    the files named, one at a time: build-tidy/'s per-file commands
-#                              (configured here when missing), as before a commit.
+#                              (configured here when missing or without a file named), as before a
+#                              commit; a file that is no source of the build is an error.
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 configure() {  # configure DIR [cmake args...]
@@ -27,6 +28,17 @@ if [[ $# -gt 0 ]]; then
   configure "$dir"
   files=()
   for f in "$@"; do files+=("$(realpath "$f")"); done
+  # A file added since build-tidy/ was configured is not in its commands: configure again, and
+  # name any file still missing (run-clang-tidy would skip it without a word).
+  missing() { for f in "${files[@]}"; do grep -q -F "\"file\": \"$f\"" "$dir/compile_commands.json" || echo "$f"; done; }
+  if [[ -n "$(missing)" ]]; then
+    rm -f "$dir/compile_commands.json"
+    configure "$dir"
+  fi
+  if [[ -n "$(missing)" ]]; then
+    echo "tidy.sh: not a source of the build (no compile command in $dir): $(missing | paste -sd ' ')" >&2
+    exit 2
+  fi
   regex=$(printf '%s|' "${files[@]}")
   regex="^(${regex%|})$"
 else

@@ -166,6 +166,7 @@ TEST(StopBeforeUnknown, EndsBeforeThePathComesNearUnobservedSpaceAndLooksAtTheWa
   observe(3, 14);
   observe(17, 30);
   std::vector<planner::Pose4> path;
+  path.reserve(90);
   for (int i = 0; i < 60; ++i) path.push_back(planner::Pose4{Eigen::Vector3d(0.1 * i + 0.05, 0.05, 1.05), 0.0});
   for (int k = 1; k <= 30; ++k) path.push_back(planner::Pose4{Eigen::Vector3d(5.95, 0.1 * k + 0.05, 1.05), M_PI / 2});
   const Eigen::Vector3d start = path.front().p_WB;
