@@ -31,7 +31,7 @@ export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$supp/
 # A unity build (CMake joins each library's sources 8 at a time): the headers (Eigen, OpenCV,
 # yaml-cpp) are parsed and their templates compiled once per 8 files, not per file (`check` took
 # 1197 s on the 2-core VM, 1354 s before). The normal build is not a unity build, so each source
-# still compiles on its own there; clang-tidy (scripts/tidy.sh) reads build-tidy/'s per-file commands.
+# still compiles on its own there; scripts/tidy.sh checks the same batches (build-tidy-unity/).
 # Ninja: the targets named below (tests, tgnav, fuzz targets) build in parallel. With Make, CMake's
 # top-level Makefile builds the targets named on its command line one after another
 # (.NOTPARALLEL), so a test program, one source, took a core while the other waited: the build
