@@ -75,9 +75,10 @@ struct StopRule {
   // height) is, or lies within clear_m of a place the vehicle has been (`visited`: the forward
   // camera never sees the vehicle's own place).
   double clear_m = 0.5;
-  double min_m = 0.5;          // ... beyond this far along the path (its own voxels: everywhere)
-  double look_m = 1.0;         // the way on: the path this far beyond where it stops
-  double half_fov_rad = 0.48;  // ... kept this close to the camera's axis at the stop
+  double min_m = 0.5;   // ... beyond this far along the path (its own voxels: everywhere)
+  double look_m = 1.0;  // the way on: the path this far beyond where it stops
+  // ... kept this close to the camera's axis at the stop (online trials: the look-ahead's)
+  double half_fov_rad = 0.48;
 };
 
 // The part of `path` (a plan from where the vehicle is) that ends before it first runs into space

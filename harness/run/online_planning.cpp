@@ -77,9 +77,6 @@ void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres
 // How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
 // is looked for when a plan's yaw is carried over to it (OnlinePlanning::renewViews).
 constexpr double kRenewWindowS = 5.0;
-// trial.stop_before_unknown: look_ahead.h's StopRule::min_m and look_m.
-constexpr double kStopMinM = 0.5;
-constexpr double kStopLookM = 1.0;
 
 }  // namespace
 
@@ -180,7 +177,9 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   }
   if (cfg_.stop_before_unknown && !external_) {
     // Observed: the robot radius and two voxels around the path (as the free places of `blocked`).
-    const StopRule rule{clear_m, kStopMinM, kStopLookM, lookAheadHalfFov(scenario_.planner.perception)};
+    StopRule rule;
+    rule.clear_m = clear_m;
+    rule.half_fov_rad = lookAheadHalfFov(scenario_.planner.perception);
     std::vector<planner::Pose4> part = stopBeforeUnknown(a.run.plan.path, built.map, visited_, rule);
     if (part.size() < a.run.plan.path.size()) {
       // The path flown from here on (the record keeps the plan's whole path).
