@@ -50,6 +50,12 @@ const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames() {
   return names;
 }
 
+const std::vector<std::pair<std::string, UnseenPrior>>& unseenPriorNames() {
+  static const std::vector<std::pair<std::string, UnseenPrior>> names = {{"blind", UnseenPrior::kBlind},
+                                                                         {"mean", UnseenPrior::kMean}};
+  return names;
+}
+
 namespace {
 
 void nonNegative(double value, const char* field) {

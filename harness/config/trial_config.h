@@ -64,6 +64,11 @@ const std::vector<std::pair<std::string, MapPose>>& mapPoseNames();  // "estimat
 // or blocked (avoided).
 enum class UnknownSpace { kFree, kBlocked };
 const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames();  // "free", "blocked"
+// How the perception model rates surfaces an online trial has not seen yet (harness/run/unseen_prior.h):
+// blind (no landmarks: a view of them gives the VO nothing), or textured like the surfaces seen so
+// far on average (mean: landmarks on the boundary of the observed free space).
+enum class UnseenPrior { kBlind, kMean };
+const std::vector<std::pair<std::string, UnseenPrior>>& unseenPriorNames();  // "blind", "mean"
 
 // The keys of an online trial (flat in `trial:`); unused in prior mode.
 struct OnlineConfig {
@@ -72,6 +77,8 @@ struct OnlineConfig {
   double prior_radius_m = 2.0;  // prior_map radius
   MapPose map_pose = MapPose::kEstimate;
   UnknownSpace unknown_space = UnknownSpace::kFree;
+  // With proposed and rrtstar (the planners that rate views). Measured: README, online planning.
+  UnseenPrior unseen_prior = UnseenPrior::kBlind;
   // A plan takes effect this long (simulated time) after the state it starts from was sampled:
   // the vehicle flies its current trajectory meanwhile. Configured, never measured.
   double plan_latency_s = 0.5;
@@ -111,6 +118,7 @@ struct OnlineConfig {
     a("prior_radius_m", prior_radius_m);
     a.choice("map_pose", map_pose, mapPoseNames());
     a.choice("unknown_space", unknown_space, unknownSpaceNames());
+    a.choice("unseen_prior", unseen_prior, unseenPriorNames());
     a("plan_latency_s", plan_latency_s);
     a("replan_period_s", replan_period_s);
     a("blend_s", blend_s);

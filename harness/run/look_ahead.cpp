@@ -203,4 +203,15 @@ control::SetpointTrajectory limitYawRate(const control::SetpointTrajectory& traj
   return control::SetpointTrajectory(t, std::move(sp));
 }
 
+double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception) {
+  return std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+}
+
+control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s) {
+  control::TrajectorySetpoint sp;
+  sp.p_WB = pose.p_WB;
+  sp.yaw_rad = pose.yaw_rad;
+  return control::SetpointTrajectory({0.0, duration_s}, {sp, sp});
+}
+
 }  // namespace tgnav::harness

@@ -8,6 +8,7 @@
 #include "control/trajectory.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
+#include "planner/perception_planner.h"
 #include "planner/pose4.h"
 #include "planner/voxel_map.h"
 
@@ -90,6 +91,12 @@ struct StopRule {
 // where it stays in observed space; the start alone, turned, where its next point is unobserved.
 std::vector<planner::Pose4> stopBeforeUnknown(const std::vector<planner::Pose4>& path, const planner::FeatureMap& map,
                                               const std::vector<Eigen::Vector3d>& visited, const StopRule& rule);
+
+// The look-ahead keeps the way ahead within the horizontal field of view, 10 deg inside its edge.
+double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception);
+
+// A trajectory that holds `pose` for `duration_s` (a vehicle without a route waits for one).
+control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s);
 
 // `trajectory` with its yaw from time `from_s` on held within `max_rate` of the yaw before it (a
 // forward pass: a faster turn is spread out and followed late, then joins the trajectory's own yaw

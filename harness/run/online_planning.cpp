@@ -9,6 +9,7 @@
 #include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/run/look_ahead.h"
+#include "harness/run/unseen_prior.h"
 #include "harness/sim/scene_geometry.h"
 
 namespace tgnav::harness {
@@ -24,26 +25,11 @@ constexpr double kBlockedStepS = 0.1;
 // follows the current route: it is not flown (a switch starts from rest). Yaw is not compared:
 // where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
 constexpr double kSameRouteM = 0.75;
-// The box of the planners' voxel map around the scene bounds (plan_run.cpp's margin).
-constexpr double kBoxMarginM = 0.5;
 
 MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   MapBuildConfig config;
   config.resolution_m = survey.resolution();
   return config;
-}
-
-// The look-ahead keeps the way ahead within the horizontal field of view, 10 deg inside its edge.
-double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception) {
-  return std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
-}
-
-// A trajectory that holds `pose` for `duration_s` (a vehicle without a route waits for one).
-control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s) {
-  control::TrajectorySetpoint sp;
-  sp.p_WB = pose.p_WB;
-  sp.yaw_rad = pose.yaw_rad;
-  return control::SetpointTrajectory({0.0, duration_s}, {sp, sp});
 }
 
 // Marks free the never-observed voxels of `tree` within `radius_m` (horizontally) of each of
@@ -149,8 +135,13 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
     free.push_back(scenario_.scene.goal.p_WB);
     markFree(&built.map.occupancy(), free, clear_m, clearanceBand(scenario_));
   }
-  a.record.snapshot_s = secondsSince(t0);
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
+  if (cfg_.unseen_prior == UnseenPrior::kMean && !external_ && planner_ != planner::PlannerKind::kAgnostic) {
+    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
+    a.record.prior_landmarks =
+        addUnseenPrior(&built.map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
+  }
+  a.record.snapshot_s = secondsSince(t0);
   Scenario from_here = scenario_;
   from_here.scene.start = start;
   const double rate_hz = scenario_.planner.trajectory.sample_rate_hz;
@@ -461,8 +452,8 @@ OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,
   }
   out.coverage = total > 0 ? static_cast<double>(known) / static_cast<double>(total) : 0.0;
   // Map error: each occupied voxel's centre against the true surfaces.
-  const Eigen::Vector3d lo = scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMarginM);
-  const Eigen::Vector3d hi = scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMarginM);
+  const Eigen::Vector3d lo = scene.bounds_min_m - Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
+  const Eigen::Vector3d hi = scene.bounds_max_m + Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
   double sum = 0.0;
   long far = 0;
   long n = 0;

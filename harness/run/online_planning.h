@@ -52,6 +52,7 @@ struct OnlinePlan {
   std::vector<bool> path_unknown;     // per point of `path`: never observed when planned
   int chosen_class = -1;
   int landmarks = 0;         // in the map it planned on
+  int prior_landmarks = 0;   // ... and those of trial.unseen_prior added to it (unseen_prior.h)
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
   double voxel_map_s = 0.0;  // wall clock
   double solve_s = 0.0;

@@ -13,8 +13,6 @@ namespace tgnav::harness {
 
 namespace {
 
-constexpr double kBoxMargin_m = 0.5;
-
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
 nlohmann::json poseRows(const std::vector<planner::Pose4>& path) {
@@ -93,9 +91,9 @@ void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& ma
   const auto t0 = std::chrono::steady_clock::now();
   const SceneConfig& scene = scenario.scene;
   const ClearanceBand band = clearanceBand(scenario);
-  run->voxels = std::make_unique<planner::VoxelMap>(map, scene.bounds_min_m - Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                    scene.bounds_max_m + Eigen::Vector3d::Constant(kBoxMargin_m),
-                                                    band.lo_m, band.hi_m, unknown_free);
+  run->voxels = std::make_unique<planner::VoxelMap>(
+      map, scene.bounds_min_m - Eigen::Vector3d::Constant(kPlanningBoxMargin_m),
+      scene.bounds_max_m + Eigen::Vector3d::Constant(kPlanningBoxMargin_m), band.lo_m, band.hi_m, unknown_free);
   run->voxel_map_s = secondsSince(t0);
 }
 

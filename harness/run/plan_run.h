@@ -41,6 +41,8 @@ struct ClearanceBand {
   double hi_m = 0.0;
 };
 ClearanceBand clearanceBand(const Scenario& scenario);
+// The planners' voxel box is the scene's bounds widened by this much.
+constexpr double kPlanningBoxMargin_m = 0.5;
 // The planners' dense voxel map of `map` into run->voxels (its time into voxel_map_s): the scene's
 // bounds widened by 0.5 m (walls lie just outside the free-space bounds and must be inside the box
 // to be seen and avoided), with the distance field over clearanceBand().

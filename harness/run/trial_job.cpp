@@ -208,6 +208,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
     j["chosen_class"] = p.chosen_class;
     j["landmarks"] = p.landmarks;
+    j["prior_landmarks"] = p.prior_landmarks;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < p.path.size(); ++i) {
       path.push_back({p.path[i].x(), p.path[i].y(), p.path[i].z(), p.path_unknown[i] ? 1 : 0});

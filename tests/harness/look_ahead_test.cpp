@@ -1,13 +1,16 @@
 // The camera's yaw in an online trial (harness/run/look_ahead.h): smoothing within a yaw-rate
 // limit that keeps the first yaw, the rate limit applied to a spliced trajectory, and the turn
-// toward the way ahead that keeps the view trackable.
+// toward the way ahead that keeps the view trackable; and the prior for unseen surfaces the
+// perception model rates those views with (harness/run/unseen_prior.h).
 #include "harness/run/look_ahead.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
+#include "harness/run/unseen_prior.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
 #include "planner/voxel_map.h"
@@ -209,6 +212,74 @@ TEST(StopBeforeUnknown, EndsBeforeThePathComesNearUnobservedSpaceAndLooksAtTheWa
   EXPECT_EQ(stopBeforeUnknown(short_path, map, {start}, rule).size(), 21U);
   const std::vector<planner::Pose4> near_end(path.begin(), path.begin() + 5);
   EXPECT_EQ(stopBeforeUnknown(near_end, map, {start}, rule).size(), 5U);
+}
+
+// A slab one voxel thick (z in [1.0, 1.1)) of 10 x 10 voxels: observed free for x < 0.5; at
+// x in [0.5, 0.6) a wall observed for y < 0.5, each of its 5 voxels holding 2 landmarks
+// (detectability 0.25 and 0.75), and not observed for y >= 0.5; nothing observed beyond.
+std::unique_ptr<planner::FeatureMap> slabMap(bool landmarks) {
+  auto map = std::make_unique<planner::FeatureMap>(0.1);
+  const auto at = [](int i, int j) {
+    return octomap::point3d(static_cast<float>(0.1 * i + 0.05), static_cast<float>(0.1 * j + 0.05), 1.05F);
+  };
+  for (int j = 0; j < 10; ++j) {
+    for (int i = 0; i < 5; ++i) map->occupancy().updateNode(at(i, j), false);
+  }
+  std::vector<planner::Landmark> seen;
+  for (int j = 0; j < 5; ++j) {
+    map->occupancy().updateNode(at(5, j), true);
+    for (int observations : {1, 3}) {
+      planner::Landmark lm;
+      lm.p_W = Eigen::Vector3d(0.52, 0.1 * j + 0.05, 1.05);
+      lm.ref_kf_p_W = Eigen::Vector3d(0.05, 0.1 * j + 0.05, 1.05);
+      lm.observations = observations;
+      lm.opportunities = 4;
+      seen.push_back(lm);
+    }
+  }
+  map->setLandmarks(landmarks ? seen : std::vector<planner::Landmark>{});
+  EXPECT_EQ(map->embedLandmarks(0.1), 0);
+  return map;
+}
+
+TEST(UnseenPrior, MeanPutsTheSeenSurfacesDensityOnTheFrontierWhereTheVoxelMapSeesIt) {
+  const Eigen::Vector3d lo(0.0, 0.0, 1.0);
+  const Eigen::Vector3d hi(0.99, 0.99, 1.09);
+  std::unique_ptr<planner::FeatureMap> map = slabMap(true);
+  const UnseenPriorStats stats = addUnseenPrior(map.get(), lo, hi);
+  EXPECT_EQ(stats.surface_voxels, 5);  // the wall's observed voxels
+  EXPECT_EQ(stats.surface_landmarks, 10);
+  EXPECT_EQ(stats.frontier_voxels, 5);  // its unobserved ones: the voxels beyond border no free space
+  EXPECT_DOUBLE_EQ(stats.density, 2.0);
+  EXPECT_DOUBLE_EQ(stats.detectability, 0.5);
+  ASSERT_EQ(stats.added, 10);
+  ASSERT_EQ(map->landmarks().size(), 20U);
+  for (int id = 10; id < 20; ++id) {
+    const Eigen::Vector3d v = map->landmarkVoxel(id);
+    EXPECT_NEAR(v.x(), 0.55, 1e-6);
+    const int voxel = (id - 10) / 2;  // two in each frontier voxel
+    EXPECT_NEAR(v.y(), 0.55 + 0.1 * voxel, 1e-6);
+    EXPECT_DOUBLE_EQ(map->landmarks()[static_cast<std::size_t>(id)].detectability(), 0.5);
+    EXPECT_FALSE(map->isKnown(v));
+  }
+  // The planners' voxel map (unknown space free, as online) sees them from the free side, beside
+  // the wall's own; without the prior only the wall's.
+  const planner::VisibilityConfig view;
+  const Eigen::Vector3d camera(0.05, 0.5, 1.05);  // every voxel of x = 0.55 in view, none grazed
+  const planner::VoxelMap voxels(*map, Eigen::Vector3d(-0.5, -0.5, 0.5), Eigen::Vector3d(1.5, 1.5, 1.5), -1e9, 1e9,
+                                 true);
+  EXPECT_EQ(voxels.visibleFrom(camera, view).size(), 20U);
+  std::unique_ptr<planner::FeatureMap> blind = slabMap(true);
+  const planner::VoxelMap without(*blind, Eigen::Vector3d(-0.5, -0.5, 0.5), Eigen::Vector3d(1.5, 1.5, 1.5), -1e9, 1e9,
+                                  true);
+  EXPECT_EQ(without.visibleFrom(camera, view).size(), 10U);
+  // Seen surfaces without landmarks (a bare scene so far), or nothing seen: nothing to average.
+  std::unique_ptr<planner::FeatureMap> bare = slabMap(false);
+  EXPECT_EQ(addUnseenPrior(bare.get(), lo, hi).added, 0);
+  EXPECT_TRUE(bare->landmarks().empty());
+  planner::FeatureMap empty(0.1);
+  const UnseenPriorStats none = addUnseenPrior(&empty, lo, hi);
+  EXPECT_EQ(none.added + none.surface_voxels + none.frontier_voxels, 0);
 }
 
 }  // namespace
