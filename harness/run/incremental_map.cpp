@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "harness/base/clock.h"
 
@@ -234,6 +235,34 @@ IncrementalMapper::Built IncrementalMapper::snapshot() const {
 }
 
 IncrementalMapper::Built IncrementalMapper::release() { return build(std::move(tree_)); }
+
+bool occupiedWithin(const octomap::OcTree& tree, const std::vector<Eigen::Vector3d>& points, double radius_m) {
+  const double res = tree.getResolution();
+  const int n = static_cast<int>(std::ceil(radius_m / res));
+  // Each voxel near the points once (neighbouring points share most of theirs).
+  std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> near;
+  for (const Eigen::Vector3d& p : points) {
+    const octomap::OcTreeKey key = tree.coordToKey(p.x(), p.y(), p.z());
+    for (int i = -n; i <= n; ++i) {
+      for (int j = -n; j <= n; ++j) {
+        for (int k = -n; k <= n; ++k) {
+          octomap::OcTreeKey v = key;
+          v[0] = static_cast<octomap::key_type>(v[0] + i);
+          v[1] = static_cast<octomap::key_type>(v[1] + j);
+          v[2] = static_cast<octomap::key_type>(v[2] + k);
+          const octomap::point3d c = tree.keyToCoord(v);
+          const Eigen::Vector3d gap =
+              ((p - Eigen::Vector3d(c.x(), c.y(), c.z())).cwiseAbs().array() - 0.5 * res).cwiseMax(0.0).matrix();
+          if (gap.norm() < radius_m) near.insert(v);
+        }
+      }
+    }
+  }
+  return std::any_of(near.begin(), near.end(), [&](const octomap::OcTreeKey& v) {
+    const octomap::OcTreeNode* node = tree.search(v);
+    return node != nullptr && tree.isNodeOccupied(node);
+  });
+}
 
 octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m) {
   const double res = tree.getResolution();

@@ -38,6 +38,10 @@ void forEachVoxel(const LeafIterator& it, double res, const Fn& fn) {
 // trial's prior of the survey near the start).
 octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m);
 
+// True when an occupied voxel of `tree` lies within `radius_m` of one of `points`: the distance
+// from the point to the voxel's cube, as the planners' clearance measures it.
+bool occupiedWithin(const octomap::OcTree& tree, const std::vector<Eigen::Vector3d>& points, double radius_m);
+
 class IncrementalMapper {
  public:
   // config.validate() is the caller's. `k`: the camera whose frames are integrated (setCamera()

@@ -262,23 +262,12 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
 }
 
 bool OnlinePlanning::blockedAhead(double tau_from) const {
-  const octomap::OcTree& tree = mapper_.occupancy();
-  const double r = scenario_.planner.perception.robot_radius_m;
   const double until = std::min(current_->endTime(), tau_from + kBlockedHorizonS);
+  std::vector<Eigen::Vector3d> ahead;
   for (double tau = std::max(tau_from, current_->startTime()); tau <= until + 1e-9; tau += kBlockedStepS) {
-    const Eigen::Vector3d p = current_->sample(tau).p_WB;
-    for (int i = -1; i <= 1; ++i) {
-      for (int j = -1; j <= 1; ++j) {
-        for (int k = -1; k <= 1; ++k) {
-          const Eigen::Vector3d q = p + r * Eigen::Vector3d(i, j, k);
-          const octomap::OcTreeNode* node =
-              tree.search(static_cast<float>(q.x()), static_cast<float>(q.y()), static_cast<float>(q.z()));
-          if (node != nullptr && tree.isNodeOccupied(node)) return true;
-        }
-      }
-    }
+    ahead.push_back(current_->sample(tau).p_WB);
   }
-  return false;
+  return occupiedWithin(mapper_.occupancy(), ahead, scenario_.planner.perception.robot_radius_m);
 }
 
 bool OnlinePlanning::sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const {

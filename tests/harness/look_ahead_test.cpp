@@ -1,7 +1,8 @@
 // The camera's yaw in an online trial (harness/run/look_ahead.h): smoothing within a yaw-rate
 // limit that keeps the first yaw, the rate limit applied to a spliced trajectory, and the turn
-// toward the way ahead that keeps the view trackable; and the prior for unseen surfaces the
-// perception model rates those views with (harness/run/unseen_prior.h).
+// toward the way ahead that keeps the view trackable; the prior for unseen surfaces the perception
+// model rates those views with (harness/run/unseen_prior.h); and the check that the path ahead is
+// blocked (occupiedWithin, harness/run/incremental_map.h).
 #include "harness/run/look_ahead.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <memory>
 #include <vector>
 
+#include "harness/run/incremental_map.h"
 #include "harness/run/unseen_prior.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
@@ -280,6 +282,23 @@ TEST(UnseenPrior, MeanPutsTheSeenSurfacesDensityOnTheFrontierWhereTheVoxelMapSee
   planner::FeatureMap empty(0.1);
   const UnseenPriorStats none = addUnseenPrior(&empty, lo, hi);
   EXPECT_EQ(none.added + none.surface_voxels + none.frontier_voxels, 0);
+}
+
+TEST(OccupiedWithin, MeasuresTheDistanceToTheVoxelsCubeAsThePlannersClearanceDoes) {
+  // One occupied voxel, the cube [0.5, 0.6] x [0, 0.1] x [1.0, 1.1]; a free one beside it.
+  octomap::OcTree tree(0.1);
+  tree.updateNode(octomap::point3d(0.55F, 0.05F, 1.05F), true);
+  tree.updateNode(octomap::point3d(0.15F, 0.05F, 1.05F), false);
+  const auto near = [&](const Eigen::Vector3d& p) { return occupiedWithin(tree, {p}, 0.3); };
+  EXPECT_TRUE(near(Eigen::Vector3d(0.25, 0.05, 1.05)));   // 0.25 m from its face
+  EXPECT_FALSE(near(Eigen::Vector3d(0.15, 0.05, 1.05)));  // 0.35 m
+  EXPECT_TRUE(near(Eigen::Vector3d(0.3, -0.2, 1.05)));    // 0.28 m from its edge
+  // 0.33 m from its edge: a probe 0.3 m along each axis from the point (the check before) lands in
+  // the voxel, 0.42 m away, and called the path blocked.
+  EXPECT_FALSE(near(Eigen::Vector3d(0.27, -0.23, 1.05)));
+  EXPECT_TRUE(near(Eigen::Vector3d(0.55, 0.05, 1.32)));  // above it, 0.22 m
+  EXPECT_TRUE(occupiedWithin(tree, {Eigen::Vector3d(-3.0, 0.0, 1.0), Eigen::Vector3d(0.55, 0.05, 0.8)}, 0.3));
+  EXPECT_FALSE(occupiedWithin(tree, {}, 0.3));
 }
 
 }  // namespace

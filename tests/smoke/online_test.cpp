@@ -154,6 +154,27 @@ TEST(OnlineTrial, StoppingBeforeUnknownSpaceShortensTheFirstTrajectoryFromNoMap)
   EXPECT_TRUE(readJson(dir / "stop/online.json")["plans"][0]["adopted"].get<bool>());
 }
 
+TEST(OnlineTrial, TheMeanPriorForUnseenSurfacesAddsLandmarksOnceSurfacesHaveBeenSeen) {
+  // trial.unseen_prior: mean. At take-off nothing is seen, so there is nothing to average: the
+  // first plan gets no prior landmarks. The next one (the first keyframe sees the smoke scene's wall
+  // across the straight line: `blocked`) does; the default (blind) adds none.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall + " --set trial.max_flight_s=2.5";
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.unseen_prior=mean --out " + (dir / "mean").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "blind").string())).rc, 0);
+  const nlohmann::json mean = readJson(dir / "mean/online.json")["plans"];
+  const nlohmann::json blind = readJson(dir / "blind/online.json")["plans"];
+  ASSERT_GE(mean.size(), 2U);
+  ASSERT_GE(blind.size(), 2U);
+  std::cout << "[ figure   ] plan at " << mean[1]["t_s"] << " s: " << mean[1]["landmarks"] << " landmarks, "
+            << mean[1]["prior_landmarks"] << " prior landmarks (mean)\n";
+  EXPECT_EQ(mean[0]["prior_landmarks"], 0);
+  EXPECT_GT(mean[1]["landmarks"].get<int>(), 0);
+  EXPECT_GT(mean[1]["prior_landmarks"].get<int>(), 0);
+  EXPECT_EQ(mean[1]["landmarks"], blind[1]["landmarks"]);  // the same map so far; the prior is on top
+  for (const nlohmann::json& p : blind) EXPECT_EQ(p["prior_landmarks"], 0);
+}
+
 TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
   const auto dir = test::tempDir();
   // The example A* planner behind a guard that makes a second start of the command fail.
