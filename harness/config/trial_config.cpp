@@ -90,6 +90,10 @@ void OnlineConfig::validate() const {
   require(std::isfinite(commit_s) && commit_s >= 0.0 && commit_s <= 60.0, "commit_s", commit_s, "must be in [0, 60]");
   require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
           "must be in [0, 10]");
+  if (look_ahead_best_view && look_ahead_keeps_tracking) {
+    throw std::invalid_argument(
+        "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
+  }
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
           "must be in [1, 100]");
   require(map_stride_px >= 1 && map_stride_px <= 64, "map_stride_px", map_stride_px, "must be in [1, 64]");

@@ -98,6 +98,11 @@ struct OnlineConfig {
   // (harness/run/look_ahead.h); false: as far as the way ahead needs, as for agnostic. Off: on
   // storage and gallery it changed no outcome (README, online planning).
   bool look_ahead_keeps_tracking = false;
+  // With proposed and rrtstar, the look-ahead's yaw keeps the way ahead within the same limit, on
+  // whichever side of it the perception model rates the view best on the map the plan was made on
+  // (the least turn at a tie; harness/run/look_ahead.h, bestViewOffset). Not with
+  // look_ahead_keeps_tracking.
+  bool look_ahead_best_view = false;
   // The built-in planners' trajectories end at rest before their path first comes within the robot
   // radius and two voxels of space unknown when planned (0.5 m on at least), the camera turned to
   // see the way on; the next plan, made once the map has grown, sends the vehicle on
@@ -126,6 +131,7 @@ struct OnlineConfig {
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
     a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);
+    a("look_ahead_best_view", look_ahead_best_view);
     a("stop_before_unknown", stop_before_unknown);
     a("renew_views", renew_views);
     a("map_every_frames", map_every_frames);

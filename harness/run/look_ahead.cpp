@@ -48,6 +48,26 @@ double trackableShare(const ViewRater& rater, double planned, double look, doubl
   return best_share;
 }
 
+double bestViewOffset(const ViewRater& rater, double planned, double heading, double half_fov) {
+  // The least turn first (the plain look-ahead's yaw), then the others from the least turn on.
+  std::vector<double> offsets = {std::clamp(std::remainder(planned - heading, 2.0 * M_PI), -half_fov, half_fov)};
+  const int n = std::max(1, static_cast<int>(std::ceil(2.0 * half_fov / kYawStepRad)));
+  for (int k = 0; k <= n; ++k) offsets.push_back(-half_fov + 2.0 * half_fov * k / n);
+  const auto turn = [&](double offset) { return std::abs(std::remainder(heading + offset - planned, 2.0 * M_PI)); };
+  std::stable_sort(offsets.begin() + 1, offsets.end(), [&](double a, double b) { return turn(a) < turn(b); });
+  double best_offset = offsets.front();
+  double best = std::numeric_limits<double>::infinity();
+  for (double offset : offsets) {
+    const double shortfall = rater.shortfall(heading + offset);
+    if (shortfall < best) {
+      best = shortfall;
+      best_offset = offset;
+    }
+    if (shortfall <= 0.0) break;
+  }
+  return best_offset;
+}
+
 void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<control::TrajectorySetpoint>* sp) {
   std::vector<control::TrajectorySetpoint>& s = *sp;
   const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
@@ -85,13 +105,14 @@ void smoothYaw(const std::vector<double>& t, double max_rate, std::vector<contro
 
 control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
                                              const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
-                                             bool always, double max_yaw_rate, ViewRater* rater) {
+                                             bool always, double max_yaw_rate, ViewRater* rater, bool best_view) {
   const std::vector<double>& t = trajectory.times();
   std::vector<control::TrajectorySetpoint> sp = trajectory.setpoints();
   if (look_ahead_s <= 0.0 || t.size() < 3) return trajectory;
   bool changed = false;
   double rated_at = -std::numeric_limits<double>::infinity();
-  double share = 1.0;  // of the turn toward the way ahead, as last rated
+  double share = 1.0;   // of the turn toward the way ahead, as last rated
+  double offset = 0.0;  // best_view: of the yaw from the way ahead, as last rated
   // The first setpoint keeps its yaw: it is the vehicle's own where the trajectory starts (and the
   // yaw it takes off with); the turn toward the way ahead follows within the rate limit.
   for (std::size_t i = 1; i < sp.size(); ++i) {
@@ -108,10 +129,18 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
       rater->moveTo(sp[i].p_WB);
       const Eigen::Vector2d near_way = (near - sp[i].p_WB).head<2>();
       const double near_heading = near_way.norm() > 0.05 ? std::atan2(near_way.y(), near_way.x()) : heading;
-      share = trackableShare(*rater, planned, look, near_heading, half_fov_rad + kNearMarginRad);
+      if (best_view) {
+        offset = bestViewOffset(*rater, planned, heading, half_fov_rad);
+      } else {
+        share = trackableShare(*rater, planned, look, near_heading, half_fov_rad + kNearMarginRad);
+      }
       rated_at = t[i];
     }
-    sp[i].yaw_rad = rater != nullptr ? planned + share * std::remainder(look - planned, 2.0 * M_PI) : look;
+    if (rater == nullptr) {
+      sp[i].yaw_rad = look;
+    } else {
+      sp[i].yaw_rad = best_view ? heading + offset : planned + share * std::remainder(look - planned, 2.0 * M_PI);
+    }
     changed = true;
   }
   if (!changed) return trajectory;

@@ -52,6 +52,14 @@ class ViewRater {
 // tie).
 double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit);
 
+// The offset from `heading` (within +-half_fov) of the yaw that keeps the way ahead in view and
+// that the rater rates least short of trackable from where it is: of the plain look-ahead's yaw
+// (the least turn from `planned`), then the yaws across the whole window, kYawStepRad apart, from
+// the least turn on, the first it rates trackable, else the least short (the least turn at a tie).
+// Unlike trackableShare it looks on both sides of the way ahead: past a corner the texture seen on
+// the way lies on the far side of it from the planner's yaw.
+double bestViewOffset(const ViewRater& rater, double planned, double heading, double half_fov);
+
 // Where `trajectory` look_ahead_s ahead (or half that) runs through space `map` has not observed
 // (or everywhere, with `always`), the yaw turns as little as it must from the planner's for the way
 // there to lie within `half_fov_rad` of the camera's axis (the camera looks before the vehicle
@@ -65,10 +73,13 @@ double trackableShare(const ViewRater& rater, double planned, double look, doubl
 // (the least shortfall where none is; the way ahead at a tie, as where nothing is mapped). The
 // first look into unknown space whose walls are bare was blind for every planner, and the VO was
 // lost there (docs/results/online10): the vehicle keeps the mapped texture in view while it turns,
-// and sees the new surfaces at the edge of the image before it looks at them.
+// and sees the new surfaces at the edge of the image before it looks at them. With `best_view`
+// (and a rater) the yaw is instead bestViewOffset's: the way ahead stays within half_fov_rad, on
+// whichever side of it the view is rated best.
 control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& trajectory,
                                              const planner::FeatureMap& map, double look_ahead_s, double half_fov_rad,
-                                             bool always, double max_yaw_rate, ViewRater* rater = nullptr);
+                                             bool always, double max_yaw_rate, ViewRater* rater = nullptr,
+                                             bool best_view = false);
 
 // Where a trajectory stops short of unknown space (trial.stop_before_unknown).
 struct StopRule {

@@ -114,10 +114,12 @@ control::SetpointTrajectory OnlinePlanning::lookAhead(const control::SetpointTra
   const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
   const double half_fov = lookAheadHalfFov(perception);
   // The perception-aware planners keep their views trackable while they look ahead.
-  const bool keep = cfg_.look_ahead_keeps_tracking && planner_ != planner::PlannerKind::kAgnostic;
+  const bool rate =
+      (cfg_.look_ahead_keeps_tracking || cfg_.look_ahead_best_view) && planner_ != planner::PlannerKind::kAgnostic;
   ViewRater rater(voxels, perception.visibility, perception.information);
   return lookWhereUnknown(trajectory, map, cfg_.look_ahead_s, half_fov, cfg_.look_ahead_always,
-                          scenario_.planner.trajectory.max_yaw_rate_rad_s, keep ? &rater : nullptr);
+                          scenario_.planner.trajectory.max_yaw_rate_rad_s, rate ? &rater : nullptr,
+                          cfg_.look_ahead_best_view);
 }
 
 OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double t_s, const std::string& trigger) {

@@ -396,6 +396,12 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t = TrialConfig{};
   t.online.prior_radius_m = 0.0;
   EXPECT_EQ(invalidArgument(t), "prior_radius_m = 0: must be > 0");
+  t = TrialConfig{};
+  t.online.look_ahead_best_view = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_ahead_keeps_tracking = true;
+  EXPECT_EQ(invalidArgument(t),
+            "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
   // Online, the vehicle flies on the pose it maps at.
   t = TrialConfig{};
   t.online.mode = TrialMode::kOnline;

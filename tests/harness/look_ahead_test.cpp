@@ -129,6 +129,35 @@ TEST(LookAhead, KeepsTheViewTrackableAsFarTowardTheWayAheadAsItMay) {
   EXPECT_GE(limited, 55.0 * kDeg - 1e-9);
 }
 
+TEST(LookAhead, TheBestViewKeepsTheWayAheadInViewOnTheSideOfTheTexture) {
+  const planner::FeatureMap map = texturedWall();
+  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
+  const planner::VisibilityConfig visibility;
+  const planner::InformationConfig information;
+  ViewRater rater(voxels, visibility, information);
+  rater.moveTo(Eigen::Vector3d(1.75, 0.0, 1.0));
+  // The way ahead at 60 deg, the planner looking at 120 deg, away from the wall (east): the least
+  // turn that keeps the way within 27.6 deg, 87.6 deg, sees no texture; the far side of the way
+  // sees the wall.
+  const double heading = 60.0 * kDeg;
+  const double half_fov = 27.6 * kDeg;
+  ASSERT_GT(rater.shortfall(heading + half_fov), 0.0);
+  const double offset = bestViewOffset(rater, 120.0 * kDeg, heading, half_fov);
+  std::cout << "[ figure   ] the best view looks at " << (heading + offset) / kDeg << " deg (way ahead: 60)\n";
+  EXPECT_LT(offset, 0.0);
+  EXPECT_GE(offset, -half_fov - 1e-9);
+  EXPECT_EQ(rater.shortfall(heading + offset), 0.0);
+  // Of the yaws it rates trackable, the least turn: the one before it (toward the planner's) is not.
+  EXPECT_GT(rater.shortfall(heading + offset + 5.0 * kDeg + 1e-6), 0.0);
+  // A planner's yaw within the window that is trackable is kept as it is.
+  ASSERT_EQ(rater.shortfall(40.0 * kDeg), 0.0);
+  EXPECT_NEAR(bestViewOffset(rater, 40.0 * kDeg, heading, half_fov), -20.0 * kDeg, 1e-12);
+  // Where no yaw in the window is trackable (way ahead north), the least short, not a blind turn
+  // toward nothing.
+  const double north = bestViewOffset(rater, 150.0 * kDeg, 90.0 * kDeg, half_fov);
+  EXPECT_LE(rater.shortfall(90.0 * kDeg + north), rater.shortfall(90.0 * kDeg + half_fov));
+}
+
 TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
   // East along y = 0 toward the wall, the planner looking south: the look-ahead turns the camera
   // east, where the wall is in view and trackable, and the rater changes nothing.
