@@ -211,7 +211,7 @@ TEST(ConfigWriter, WritesExactShortestDecimalsAndTypedScalars) {
 template <typename Config, typename Load>
 Config roundTrip(const Config& c, Load load, const std::filesystem::path& dir) {
   const std::string text = dump(toYaml(c));
-  const Config back = load(test::writeFile(dir / "config.yaml", text + "\n"));
+  Config back = load(test::writeFile(dir / "config.yaml", text + "\n"));
   EXPECT_EQ(dump(toYaml(back)), text);
   return back;
 }
