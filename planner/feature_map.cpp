@@ -116,19 +116,14 @@ int FeatureMap::embedLandmarks(double max_shift_m) {
   return dropped;
 }
 
-void FeatureMap::addPlacedLandmarks(const std::vector<Landmark>& landmarks,
-                                    const std::vector<Eigen::Vector3d>& voxels_W) {
-  if (landmarks.size() != voxels_W.size()) {
-    throw std::invalid_argument("FeatureMap::addPlacedLandmarks: " + std::to_string(landmarks.size()) +
-                                " landmarks for " + std::to_string(voxels_W.size()) + " voxels");
-  }
+void FeatureMap::addPlacedLandmarks(const std::vector<Landmark>& landmarks) {
   if (landmark_key_.size() != landmarks_.size()) {
     throw std::logic_error("FeatureMap::addPlacedLandmarks: the map's landmarks are not embedded");
   }
-  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+  for (const Landmark& lm : landmarks) {
     const auto id = static_cast<int>(landmarks_.size());
-    landmarks_.push_back(landmarks[i]);
-    landmark_key_.push_back(tree_->coordToKey(toOcto(voxels_W[i])));
+    landmarks_.push_back(lm);
+    landmark_key_.push_back(tree_->coordToKey(toOcto(lm.p_W)));
     by_voxel_[landmark_key_.back()].push_back(id);
   }
 }

@@ -83,10 +83,10 @@ class FeatureMap {
   // within `max_shift_m` of it. Landmarks without such a voxel (seen through free space, or
   // occluded from their own keyframe) are dropped. Returns how many were dropped.
   int embedLandmarks(double max_shift_m);
-  // Appends landmarks already placed: landmark i in the voxel holding voxels_W[i], without a ray
-  // from a keyframe (after embedLandmarks(); e.g. an online trial's prior for unseen surfaces, which
-  // lie in voxels not observed occupied: visibleFrom() never finds those, VoxelMap does).
-  void addPlacedLandmarks(const std::vector<Landmark>& landmarks, const std::vector<Eigen::Vector3d>& voxels_W);
+  // Appends landmarks already placed: each in the voxel holding its p_W, without a ray from a
+  // keyframe (after embedLandmarks(); e.g. an online trial's prior for unseen surfaces, which lie
+  // in voxels not observed occupied: visibleFrom() never finds those, VoxelMap does).
+  void addPlacedLandmarks(const std::vector<Landmark>& landmarks);
   // Voxel centre each landmark is embedded in (after embedLandmarks()).
   Eigen::Vector3d landmarkVoxel(int id) const;
 

@@ -127,11 +127,11 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
         heading + std::clamp(std::remainder(planned - heading, 2.0 * M_PI), -half_fov_rad, half_fov_rad);
     if (rater != nullptr && t[i] >= rated_at + kRateEveryS - 1e-9) {
       rater->moveTo(sp[i].p_WB);
-      const Eigen::Vector2d near_way = (near - sp[i].p_WB).head<2>();
-      const double near_heading = near_way.norm() > 0.05 ? std::atan2(near_way.y(), near_way.x()) : heading;
       if (best_view) {
         offset = bestViewOffset(*rater, planned, heading, half_fov_rad);
       } else {
+        const Eigen::Vector2d near_way = (near - sp[i].p_WB).head<2>();
+        const double near_heading = near_way.norm() > 0.05 ? std::atan2(near_way.y(), near_way.x()) : heading;
         share = trackableShare(*rater, planned, look, near_heading, half_fov_rad + kNearMarginRad);
       }
       rated_at = t[i];

@@ -109,7 +109,6 @@ UnseenPriorStats addUnseenPrior(planner::FeatureMap* map, const Eigen::Vector3d&
   prior.observations = std::max(1, static_cast<int>(std::lround(out.detectability * kChances)));
   // The density spread evenly: each frontier voxel takes what the running sum has reached.
   std::vector<planner::Landmark> landmarks;
-  std::vector<Eigen::Vector3d> voxels;
   double owed = 0.0;
   for (int i : frontier) {
     owed += out.density;
@@ -119,13 +118,10 @@ UnseenPriorStats addUnseenPrior(planner::FeatureMap* map, const Eigen::Vector3d&
     const octomap::point3d c = tree.keyToCoord(box.key(i));
     prior.p_W = Eigen::Vector3d(c.x(), c.y(), c.z());
     prior.ref_kf_p_W = prior.p_W;
-    for (int k = 0; k < n; ++k) {
-      landmarks.push_back(prior);
-      voxels.push_back(prior.p_W);
-    }
+    landmarks.insert(landmarks.end(), static_cast<std::size_t>(n), prior);
   }
   out.added = static_cast<int>(landmarks.size());
-  map->addPlacedLandmarks(landmarks, voxels);
+  map->addPlacedLandmarks(landmarks);
   return out;
 }
 

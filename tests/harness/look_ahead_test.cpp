@@ -101,12 +101,19 @@ planner::FeatureMap texturedWall() {
 
 constexpr double kDeg = M_PI / 180.0;
 
+// texturedWall() as the planners' voxel map (unknown space free), and a rater of views on it (the
+// gates: 50 detections, a fifth of the image).
+struct WallViews {
+  planner::FeatureMap map = texturedWall();
+  planner::VoxelMap voxels{map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true};
+  planner::VisibilityConfig visibility;
+  planner::InformationConfig information;
+  ViewRater rater{voxels, visibility, information};
+};
+
 TEST(LookAhead, KeepsTheViewTrackableAsFarTowardTheWayAheadAsItMay) {
-  const planner::FeatureMap map = texturedWall();
-  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
-  const planner::VisibilityConfig visibility;
-  planner::InformationConfig information;  // the gates: 50 detections, a fifth of the image
-  ViewRater rater(voxels, visibility, information);
+  WallViews wall;
+  ViewRater& rater = wall.rater;
   rater.moveTo(Eigen::Vector3d(1.75, 0.0, 1.0));
   // The planner looks at the wall; the way ahead turns north, where nothing is known.
   const double planned = 0.0;
@@ -130,11 +137,8 @@ TEST(LookAhead, KeepsTheViewTrackableAsFarTowardTheWayAheadAsItMay) {
 }
 
 TEST(LookAhead, TheBestViewKeepsTheWayAheadInViewOnTheSideOfTheTexture) {
-  const planner::FeatureMap map = texturedWall();
-  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
-  const planner::VisibilityConfig visibility;
-  const planner::InformationConfig information;
-  ViewRater rater(voxels, visibility, information);
+  WallViews wall;
+  ViewRater& rater = wall.rater;
   rater.moveTo(Eigen::Vector3d(1.75, 0.0, 1.0));
   // The way ahead at 60 deg, the planner looking at 120 deg, away from the wall (east): the least
   // turn that keeps the way within 27.6 deg, 87.6 deg, sees no texture; the far side of the way
@@ -161,11 +165,8 @@ TEST(LookAhead, TheBestViewKeepsTheWayAheadInViewOnTheSideOfTheTexture) {
 TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
   // East along y = 0 toward the wall, the planner looking south: the look-ahead turns the camera
   // east, where the wall is in view and trackable, and the rater changes nothing.
-  const planner::FeatureMap map = texturedWall();
-  const planner::VoxelMap voxels(map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true);
-  const planner::VisibilityConfig visibility;
-  const planner::InformationConfig information;
-  ViewRater rater(voxels, visibility, information);
+  WallViews wall;
+  ViewRater& rater = wall.rater;
   std::vector<double> t;
   std::vector<control::TrajectorySetpoint> sp;
   for (int i = 0; i <= 600; ++i) {
@@ -176,8 +177,8 @@ TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
     sp.push_back(s);
   }
   const control::SetpointTrajectory east(t, sp);
-  const control::SetpointTrajectory plain = lookWhereUnknown(east, map, 2.0, 27.6 * kDeg, false, 0.6);
-  const control::SetpointTrajectory rated = lookWhereUnknown(east, map, 2.0, 27.6 * kDeg, false, 0.6, &rater);
+  const control::SetpointTrajectory plain = lookWhereUnknown(east, wall.map, 2.0, 27.6 * kDeg, false, 0.6);
+  const control::SetpointTrajectory rated = lookWhereUnknown(east, wall.map, 2.0, 27.6 * kDeg, false, 0.6, &rater);
   for (double at : {1.0, 3.0, 5.0}) {
     EXPECT_GT(plain.sample(at).yaw_rad, -60.0 * kDeg);  // turned toward the way ahead
     EXPECT_DOUBLE_EQ(rated.sample(at).yaw_rad, plain.sample(at).yaw_rad);
