@@ -25,6 +25,9 @@ constexpr double kBlockedStepS = 0.1;
 // follows the current route: it is not flown (a switch starts from rest). Yaw is not compared:
 // where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
 constexpr double kSameRouteM = 0.75;
+// A switch's blend may be lengthened up to this many times trial.blend_s to keep the acceleration
+// limit (control::spliceWithinAccel).
+constexpr double kMaxBlendFactor = 4.0;
 
 MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   MapBuildConfig config;
@@ -315,9 +318,13 @@ void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
+  // The blend is lengthened (up to kMaxBlendFactor times) until it keeps the trajectories'
+  // acceleration limit.
+  const planner::TrajectoryConfig& limits = scenario_.planner.trajectory;
   current_ = std::make_unique<control::SetpointTrajectory>(
-      limitYawRate(control::spliceTrajectory(*current_, next, tau_switch, blend_s), tau_switch,
-                   scenario_.planner.trajectory.max_yaw_rate_rad_s));
+      limitYawRate(control::spliceWithinAccel(*current_, next, tau_switch, blend_s, limits.max_accel_mps2,
+                                              kMaxBlendFactor * blend_s),
+                   tau_switch, limits.max_yaw_rate_rad_s));
 }
 
 void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s) {
