@@ -12,8 +12,8 @@ namespace tgnav::control {
 
 namespace {
 
-using Vector6d = Eigen::Matrix<double, 6, 1>;
-using Matrix6d = Eigen::Matrix<double, 6, 6>;
+using Vector9d = Eigen::Matrix<double, 9, 1>;
+using Matrix9d = Eigen::Matrix<double, 9, 9>;
 
 // Rotation vector -> unit quaternion; the series keeps small angles (and exactly zero) exact.
 Eigen::Quaterniond expMap(const Eigen::Vector3d& theta) {
@@ -31,14 +31,17 @@ Eigen::Vector3d logMap(const Eigen::Quaterniond& q_in) {
   return k * q.vec();
 }
 
-// Constant-velocity transition over dt: p += v dt.
-Matrix6d transition(double dt_s) {
-  Matrix6d F = Matrix6d::Identity();
-  F.topRightCorner<3, 3>().diagonal().setConstant(dt_s);
+// Transition over dt without input: p += v dt - b dt^2/2, v -= b dt (the bias is taken off the
+// measured acceleration), b constant. F(s) F(t) = F(s + t).
+Matrix9d transition(double dt_s) {
+  Matrix9d F = Matrix9d::Identity();
+  F.block<3, 3>(0, 3).diagonal().setConstant(dt_s);
+  F.block<3, 3>(0, 6).diagonal().setConstant(-0.5 * dt_s * dt_s);
+  F.block<3, 3>(3, 6).diagonal().setConstant(-dt_s);
   return F;
 }
 
-Matrix6d symmetric(const Matrix6d& P) { return 0.5 * (P + P.transpose()); }
+Matrix9d symmetric(const Matrix9d& P) { return 0.5 * (P + P.transpose()); }
 
 }  // namespace
 
@@ -49,6 +52,8 @@ void EstimatorConfig::validate() const {
   require(gyro_bias_gain >= 0.0 && gyro_bias_gain < 1.0, "gyro_bias_gain", gyro_bias_gain, "must be in [0, 1)");
   require(max_position_innovation_m > 0.0, "max_position_innovation_m", max_position_innovation_m, "must be > 0");
   require(history_s > 0.0, "history_s", history_s, "must be > 0");
+  require(accel_bias_walk_m_s2_sqrt_s >= 0.0 && std::isfinite(accel_bias_walk_m_s2_sqrt_s),
+          "accel_bias_walk_m_s2_sqrt_s", accel_bias_walk_m_s2_sqrt_s, "must be >= 0");
 }
 
 StateEstimator::StateEstimator(const EstimatorConfig& config, double gravity_m_s2)
@@ -60,8 +65,9 @@ StateEstimator::StateEstimator(const EstimatorConfig& config, double gravity_m_s
 
 void StateEstimator::reset(const VehicleState& initial, double t_s) {
   t_s_ = t_s;
-  x_ << initial.p_WB, initial.v_WB;
-  // The start is known (the vehicle stands where the trial put it); uncertainty comes from the IMU.
+  x_ << initial.p_WB, initial.v_WB, Eigen::Vector3d::Zero();
+  // The start is known (the vehicle stands where the trial put it); uncertainty comes from the IMU
+  // (and the bias from its random walk).
   P_.setZero();
   q_WB_ = initial.q_WB.normalized();
   gyro_bias_.setZero();
@@ -88,13 +94,17 @@ void StateEstimator::propagate(const ImuSample& imu) {
   q_WB_ = (q_WB_ * expMap(dt * w_B)).normalized();
   const Eigen::Vector3d a_W = q_mid * imu.f_B - Eigen::Vector3d(0.0, 0.0, gravity_m_s2_);
 
-  // Discrete white acceleration, sigma per sample: G = [dt^2/2 I; dt I], Q = G G^T sigma^2.
-  Eigen::Matrix<double, 6, 3> G;
-  G << 0.5 * dt * dt * Eigen::Matrix3d::Identity(), dt * Eigen::Matrix3d::Identity();
-  const Matrix6d F = transition(dt);
+  // Discrete white acceleration, sigma per sample: G = [dt^2/2 I; dt I; 0], Q = G G^T sigma^2, and
+  // the bias's random walk, walk^2 dt.
+  Eigen::Matrix<double, 9, 3> G = Eigen::Matrix<double, 9, 3>::Zero();
+  G << 0.5 * dt * dt * Eigen::Matrix3d::Identity(), dt * Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Zero();
+  const Matrix9d F = transition(dt);
   x_ = F * x_ + G * a_W;
   const double var = config_.accel_noise_m_s2 * config_.accel_noise_m_s2;
-  P_ = symmetric(F * P_ * F.transpose() + var * G * G.transpose());
+  P_ = F * P_ * F.transpose() + var * G * G.transpose();
+  P_.bottomRightCorner<3, 3>().diagonal().array() +=
+      config_.accel_bias_walk_m_s2_sqrt_s * config_.accel_bias_walk_m_s2_sqrt_s * dt;
+  P_ = symmetric(P_);
   t_s_ = imu.t_s;
 
   history_.push_back(Snapshot{t_s_, x_, P_, q_WB_});
@@ -128,12 +138,12 @@ bool StateEstimator::fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB) {
   // Kalman update at the snapshot, H = [I 0]: P H^T is P's left block column.
   const double r = config_.position_sigma_m * config_.position_sigma_m;
   const Eigen::Matrix3d S = m.P.topLeftCorner<3, 3>() + r * Eigen::Matrix3d::Identity();
-  const Eigen::Matrix<double, 6, 3> K = m.P.leftCols<3>() * S.inverse();
-  const Vector6d dx = K * y;
-  Matrix6d I_KH = Matrix6d::Identity();
+  const Eigen::Matrix<double, 9, 3> K = m.P.leftCols<3>() * S.inverse();
+  const Vector9d dx = K * y;
+  Matrix9d I_KH = Matrix9d::Identity();
   I_KH.leftCols<3>() -= K;
-  const Matrix6d P_post = I_KH * m.P * I_KH.transpose() + r * K * K.transpose();  // Joseph form
-  const Matrix6d dP = m.P - P_post;
+  const Matrix9d P_post = I_KH * m.P * I_KH.transpose() + r * K * K.transpose();  // Joseph form
+  const Matrix9d dP = m.P - P_post;
 
   // Attitude: a fraction of the body-frame error at t_meas, applied as the rotation in W that
   // re-integrating the gyro from the corrected snapshot attitude would give at every later time.
@@ -151,7 +161,7 @@ bool StateEstimator::fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB) {
   // F dP F^T at every later snapshot is what re-running the filter from t_m would give.
   const double t_m = m.t_s;
   for (auto j = it; j != history_.end(); ++j) {
-    const Matrix6d F = transition(j->t_s - t_m);
+    const Matrix9d F = transition(j->t_s - t_m);
     j->x += F * dx;
     j->P = symmetric(j->P - F * dP * F.transpose());
     j->q_WB = (dq_W * j->q_WB).normalized();
@@ -170,7 +180,7 @@ bool StateEstimator::fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB) {
 VehicleState StateEstimator::state() const {
   VehicleState s;
   s.p_WB = x_.head<3>();
-  s.v_WB = x_.tail<3>();
+  s.v_WB = x_.segment<3>(3);
   s.q_WB = q_WB_;
   s.w_B = gyro_B_ - gyro_bias_;
   return s;

@@ -3,19 +3,26 @@
 // propagates position, velocity and attitude at its own rate; poses from the visual odometry
 // correct them when they arrive, which is later than the image they were measured on.
 //
-//   position/velocity: a linear Kalman filter, state [p_WB; v_WB], input the accelerometer's
-//     specific force rotated into W plus gravity, measurement the VO's body position;
+//   position/velocity: a linear Kalman filter, state [p_WB; v_WB; b_W], input the accelerometer's
+//     specific force rotated into W plus gravity, less b_W, measurement the VO's body position.
+//     b_W is a slowly wandering acceleration bias in W (a random walk, `accel_bias_walk`; 0 keeps it
+//     at zero, the filter then being the [p; v] one): what a tilt error of the attitude leaks of
+//     gravity (g sin(err), 0.17 m/s^2 per degree; the attitude follows the VO's, whose roll and pitch
+//     drift) and the accelerometer's own bias. Unestimated, it leaves the velocity biased while the
+//     position follows the VO: the controller then holds off its setpoint by that bias / its
+//     position gain;
 //   attitude: gyro integration, pulled towards the VO's attitude by a fixed fraction of the
 //     rotation error at each VO pose (a complementary filter);
 //   body rates: the gyro, less the gyro bias estimate (zero unless `gyro_bias_gain` > 0).
 //
 // A VO pose taken at t_m is fused at a later time t (the caller's latency): the innovation is
 // formed against the estimate stored at t_m, and the correction is carried forward to t through
-// the constant-velocity transition, so a late measurement does not pull the estimate back in time.
+// the transition, so a late measurement does not pull the estimate back in time.
 // Without VO poses (tracking lost) the estimate dead-reckons on the IMU and drifts, as a real
 // vehicle's would.
 //
-// Because the transition F(dt) = [I dt*I; 0 I] does not depend on the state, carrying the
+// Because the transition F(dt) = [I dt*I -dt^2/2*I; 0 I -dt*I; 0 0 I] does not depend on the state
+// (and F(s) F(t) = F(s + t)), carrying the
 // correction (and the covariance reduction) forward is exactly what re-running the filter from t_m
 // with the measurement inserted would give, for poses fused in order of their measurement times
 // (t_m rounded to the nearest IMU sample); poses older than one already fused are rejected. The
@@ -42,6 +49,8 @@ struct EstimatorConfig {
   double gyro_bias_gain = 0.0;
   double max_position_innovation_m = 1.0;  // VO poses further than this from the estimate are rejected
   double history_s = 1.0;                  // how old a fused measurement may be
+  // Random walk of the acceleration bias b_W, sigma [m/s^2 per sqrt(s)]; 0: not estimated.
+  double accel_bias_walk_m_s2_sqrt_s = 0.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -52,6 +61,7 @@ struct EstimatorConfig {
     a("gyro_bias_gain", gyro_bias_gain);
     a("max_position_innovation_m", max_position_innovation_m);
     a("history_s", history_s);
+    a("accel_bias_walk_m_s2_sqrt_s", accel_bias_walk_m_s2_sqrt_s);
   }
 
   void validate() const;  // std::invalid_argument naming the field and value
@@ -83,7 +93,10 @@ class StateEstimator {
 
   VehicleState state() const;
   double time() const { return t_s_; }
-  Eigen::Matrix<double, 6, 6> covariance() const { return P_; }
+  // Covariance of [p_WB; v_WB] (covarianceWithBias: of [p_WB; v_WB; b_W]).
+  Eigen::Matrix<double, 6, 6> covariance() const { return P_.topLeftCorner<6, 6>(); }
+  const Eigen::Matrix<double, 9, 9>& covarianceWithBias() const { return P_; }
+  Eigen::Vector3d accelBias() const { return x_.tail<3>(); }  // b_W
   int fused() const { return fused_; }
   int rejected() const { return rejected_; }
 
@@ -91,16 +104,16 @@ class StateEstimator {
   // The estimate right after the propagation (or reset) to t_s; history_.back() is the current one.
   struct Snapshot {
     double t_s;
-    Eigen::Matrix<double, 6, 1> x;
-    Eigen::Matrix<double, 6, 6> P;
+    Eigen::Matrix<double, 9, 1> x;
+    Eigen::Matrix<double, 9, 9> P;
     Eigen::Quaterniond q_WB;
   };
 
   EstimatorConfig config_;
   double gravity_m_s2_;
   double t_s_ = 0.0;
-  Eigen::Matrix<double, 6, 1> x_ = Eigen::Matrix<double, 6, 1>::Zero();  // [p_WB; v_WB]
-  Eigen::Matrix<double, 6, 6> P_ = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 9, 1> x_ = Eigen::Matrix<double, 9, 1>::Zero();  // [p_WB; v_WB; b_W]
+  Eigen::Matrix<double, 9, 9> P_ = Eigen::Matrix<double, 9, 9>::Zero();
   Eigen::Quaterniond q_WB_ = Eigen::Quaterniond::Identity();
   Eigen::Vector3d gyro_bias_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro_B_ = Eigen::Vector3d::Zero();  // last gyro sample, bias not removed
