@@ -314,16 +314,19 @@ void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   }
   if (tt.size() < 3) return;
   smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
-  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s,
+           false);
 }
 
-void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
+void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s, bool urgent) {
   // The blend is lengthened (up to kMaxBlendFactor times) until it keeps the trajectories'
-  // acceleration limit.
+  // acceleration limit, unless the path ahead is blocked: a longer blend would fly on towards the
+  // obstacle for longer (seen: two collisions on storage with the vehicle 0.5-1 s into a
+  // lengthened blend away from a blocked path).
   const planner::TrajectoryConfig& limits = scenario_.planner.trajectory;
+  const double longest = urgent ? blend_s : kMaxBlendFactor * blend_s;
   current_ = std::make_unique<control::SetpointTrajectory>(
-      limitYawRate(control::spliceWithinAccel(*current_, next, tau_switch, blend_s, limits.max_accel_mps2,
-                                              kMaxBlendFactor * blend_s),
+      limitYawRate(control::spliceWithinAccel(*current_, next, tau_switch, blend_s, limits.max_accel_mps2, longest),
                    tau_switch, limits.max_yaw_rate_rad_s));
 }
 
@@ -388,7 +391,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
     last_change_s_ = t_s;
-    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
+    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s, a.record.trigger == "blocked");
     pending_until_s_ = t_eff;
     failed_in_a_row_ = 0;
     holding_ = false;
@@ -404,10 +407,11 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     why << failed_in_a_row_ << " plans in a row found no route (last: " << a.record.detail << ")";
     return why.str();
   }
-  if (spent || blockedAhead(tau_now)) {
+  const bool blocked = blockedAhead(tau_now);
+  if (spent || blocked) {
     // Stop where the current trajectory is at the switch, and wait for a route.
     switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s), tau_switch,
-             before_start ? 0.0 : cfg_.blend_s);
+             before_start ? 0.0 : cfg_.blend_s, blocked);
     holding_ = true;
     pending_until_s_ = t_eff;
   }
