@@ -26,6 +26,8 @@
 //   sweep.yaml     the sweep file as first run (a copy)
 //   trials.csv     the manifest: every trial of the sweep (id,scenario,scene,planner,samples,seed,params)
 //   commands.txt   each trial's `tgnav trial` arguments (run in DIR)
+//   scenarios/     each scenario resolved when the sweep first ran (its first line names it); the
+//                  trials run these, so editing configs/ later changes none of them (sweep_runner.cpp)
 //   index.csv      the finished trials with their headline metrics, in manifest order; rebuilt
 //                  from the trial folders, so it never loses or repeats a trial
 //   trials/<id>/   one `tgnav trial` folder each; finished when it holds a valid metrics.json

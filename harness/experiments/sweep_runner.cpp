@@ -2,10 +2,14 @@
 
 #include <cstdio>
 #include <map>
+#include <set>
 #include <stdexcept>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "harness/base/errors.h"
+#include "harness/base/files.h"
 #include "harness/config/scenario.h"
 #include "harness/config/yaml_util.h"
 #include "harness/experiments/sweep_local.h"
@@ -84,6 +88,59 @@ void prebuildMaps(const SweepRun& run) {
   }
 }
 
+constexpr const char* kSnapshotPrefix = "# tgnav sweep: the resolved scenario of ";
+constexpr const char* kSnapshotSuffix = ", as the sweep first ran";
+
+// Points every trial at a snapshot of its scenario in DIR/scenarios/, so that editing configs/
+// under a running or stopped sweep changes none of its trials; returns the snapshots still to
+// write (scenario, snapshot), which writeSnapshots() writes once the folder is known to hold this
+// sweep. A folder made before snapshots (its commands.txt names no DIR/scenarios/) keeps its
+// trials' scenarios as they are.
+std::vector<std::pair<fs::path, fs::path>> snapshotScenarios(const SweepDir& dir, Sweep* sweep) {
+  const fs::path folder = fs::absolute(dir.path()).lexically_normal() / "scenarios";
+  const fs::path commands = dir.path() / "commands.txt";
+  if (fs::exists(commands) && readTextFile(commands).find(folder.string() + "/") == std::string::npos) return {};
+  std::map<fs::path, fs::path> held;  // scenario -> its snapshot, from the snapshots' first lines
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    const std::string text = readTextFile(e.path());
+    const std::string first = text.substr(0, text.find('\n'));
+    const std::size_t prefix = std::string(kSnapshotPrefix).size();
+    const std::size_t end = first.rfind(kSnapshotSuffix);
+    if (first.rfind(kSnapshotPrefix, 0) == 0 && end != std::string::npos && end > prefix) {
+      held[fs::path(first.substr(prefix, end - prefix))] = e.path();
+    }
+  }
+  std::vector<std::pair<fs::path, fs::path>> to_write;
+  std::set<fs::path> taken;
+  for (const auto& [scenario, snapshot] : held) taken.insert(snapshot);
+  for (SweepTrial& t : sweep->trials) {
+    auto it = held.find(t.scenario);
+    if (it == held.end()) {
+      const std::string stem = t.scenario.stem().string();
+      fs::path to = folder / (stem + ".yaml");
+      for (int n = 2; taken.count(to) != 0 || fs::exists(to); ++n)
+        to = folder / (stem + "-" + std::to_string(n) + ".yaml");
+      taken.insert(to);
+      to_write.emplace_back(t.scenario, to);
+      it = held.emplace(t.scenario, to).first;
+    }
+    t.scenario = it->second;
+  }
+  return to_write;
+}
+
+// Each scenario resolved (every setting in force, resolvedScenarioYaml), under a first line that
+// names it.
+void writeSnapshots(const fs::path& folder, const std::vector<std::pair<fs::path, fs::path>>& snapshots) {
+  if (snapshots.empty()) return;
+  makeOutputDir(folder);
+  for (const auto& [scenario, to] : snapshots) {
+    writeFileAtomic(to, std::string(kSnapshotPrefix) + scenario.string() + kSnapshotSuffix + "\n" +
+                            resolvedScenarioYaml(loadScenario(scenario)));
+  }
+}
+
 // The sweep's trials, their states after tidying, and which of them are not done.
 SweepRun planRun(const SweepDir& dir, const Sweep& sweep) {
   SweepRun run;
@@ -104,12 +161,14 @@ int runSweep(const SweepOptions& opt) {
   const SweepDir dir(opt.out);
   checkSweepFolder(dir);
   // Generated scenes are written here (complete, each on its own) while the sweep file is checked.
-  const Sweep sweep = loadSweep(opt.sweep, fs::absolute(dir.path()) / "scenes");
+  Sweep sweep = loadSweep(opt.sweep, fs::absolute(dir.path()) / "scenes");
   makeOutputDir(dir.path());
   const FolderLock lock(dir.path() / ".lock", /*inherit=*/true, 120.0,
                         "tgnav sweep: " + dir.path().string() +
                             " is locked (another sweep, or the trials of a killed one still stopping); waiting...");
+  const std::vector<std::pair<fs::path, fs::path>> snapshots = snapshotScenarios(dir, &sweep);
   dir.prepare(sweep);
+  writeSnapshots(fs::absolute(dir.path()).lexically_normal() / "scenarios", snapshots);
   refuseWhileSlurmRuns(dir);
   SweepRun run = planRun(dir, sweep);
   if (run.todo.empty()) {

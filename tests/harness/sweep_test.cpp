@@ -10,11 +10,13 @@
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <set>
 #include <sstream>
 
 #include "harness/base/shell.h"
+#include "harness/config/scenario.h"
 #include "harness/experiments/sweep_folder.h"
 #include "harness/experiments/sweep_runner.h"
 #include "tests/harness/test_util.h"
@@ -526,6 +528,60 @@ TEST(SweepRunner, LocalRunResumesReportsFailuresAndTidies) {
               runSweep(other);
             }).find("holds another sweep: its commands.txt differs from " + other.sweep + "'s at line 1"),
             std::string::npos);
+}
+
+TEST(SweepRunner, TrialsRunSnapshotsOfTheirScenariosThatEditingTheConfigsDoesNotChange) {
+  // A scenario whose trial settings live in a file beside it, as configs/trial.yaml does.
+  const fs::path dir = test::tempDir();
+  fs::create_directories(dir / "cfg");
+  const fs::path trial_yaml = test::writeFile(dir / "cfg" / "mine_trial.yaml", "goal_radius_m: 0.4\n");
+  const fs::path scenario = test::writeFile(dir / "cfg" / "mine.yaml",
+                                            "scene: " + (test::sourceDir() / "configs/scenes/smoke.yaml").string() +
+                                                "\nseed: 1\ntrial_config: mine_trial.yaml\n");
+  SweepOptions opt = smokeSweep(dir, 3);
+  opt.sweep = test::writeFile(dir / "sweep.yaml",
+                              "seeds: 3\nruns:\n  - {scenario: cfg/mine.yaml, planner: rrtstar, samples: 300}\n");
+  const fs::path out = opt.out;
+  const fs::path snapshot = out / "scenarios" / "mine.yaml";
+
+  Captured c = [&] {
+    const ScopedEnv fail("FAKE_FAIL_SEED", "3");
+    return capture([&] { return runSweep(opt); });
+  }();
+  EXPECT_EQ(c.rc, 1) << c.err;
+  ASSERT_TRUE(fs::exists(snapshot));
+  EXPECT_EQ(readText(snapshot).rfind("# tgnav sweep: the resolved scenario of " + scenario.string() + ",", 0), 0u);
+  EXPECT_DOUBLE_EQ(loadScenario(snapshot).trial.goal_radius_m, 0.4);
+  const std::string commands = readText(out / "commands.txt");
+  EXPECT_NE(commands.find("rrtstar-300__s03 trial --scenario " + snapshot.string() + " "), std::string::npos)
+      << commands;
+  EXPECT_EQ(commands.find(scenario.string()), std::string::npos) << commands;
+
+  // The configs edited before the sweep is resumed: the trial left runs on the snapshot.
+  test::writeFile(trial_yaml, "goal_radius_m: 0.6\n");
+  const std::string held = readText(snapshot);
+  c = capture([&] { return runSweep(opt); });
+  EXPECT_EQ(c.rc, 0) << c.err;
+  EXPECT_EQ(readText(snapshot), held);
+  EXPECT_EQ(readText(out / "commands.txt"), commands);
+  EXPECT_EQ(indexIds(out).size(), 3u);
+  std::error_code ec;
+  EXPECT_EQ(std::distance(fs::directory_iterator(out / "scenarios", ec), fs::directory_iterator()), 1);
+
+  // A folder made before snapshots (its commands name the scenario itself) is resumed as it was.
+  const fs::path old_out = dir / "old";
+  fs::create_directories(old_out);
+  std::string old_commands = commands;
+  for (std::size_t i = old_commands.find(snapshot.string()); i != std::string::npos;
+       i = old_commands.find(snapshot.string(), i)) {
+    old_commands.replace(i, snapshot.string().size(), scenario.string());
+  }
+  test::writeFile(old_out / "commands.txt", old_commands);
+  opt.out = old_out.string();
+  c = capture([&] { return runSweep(opt); });
+  EXPECT_EQ(c.rc, 0) << c.err;
+  EXPECT_FALSE(fs::exists(old_out / "scenarios"));
+  EXPECT_EQ(readText(old_out / "commands.txt"), old_commands);
 }
 
 TEST(SweepRunner, SlurmBackendSubmitsAJobArrayAndRefusesWhileItRuns) {

@@ -287,8 +287,8 @@ TEST_F(Faults, DiskFullWhileASweepIndexIsWrittenKeepsTheOldIndex) {
   for (const std::string& name : visibleEntries(out)) {
     if (name[0] != '.' && fs::path(name).extension() != ".tmp") names.push_back(name);
   }
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"commands.txt", "index.csv", "logs", "sweep.yaml", "trials", "trials.csv"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"commands.txt", "index.csv", "logs", "scenarios", "sweep.yaml", "trials",
+                                             "trials.csv"}));
 }
 
 }  // namespace
