@@ -97,30 +97,4 @@ SetpointTrajectory spliceTrajectory(const SetpointTrajectory& current, const Set
   return SetpointTrajectory(std::move(t), std::move(sp));
 }
 
-double peakAcceleration(const SetpointTrajectory& trajectory, double from_s, double to_s) {
-  double peak = 0.0;
-  const std::vector<double>& t = trajectory.times();
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] >= from_s - 1e-9 && t[i] <= to_s + 1e-9) peak = std::max(peak, trajectory.setpoints()[i].a_WB.norm());
-  }
-  return peak;
-}
-
-SetpointTrajectory spliceWithinAccel(const SetpointTrajectory& current, const SetpointTrajectory& next, double t_switch,
-                                     double blend_s, double max_accel, double max_blend_s, double* blend_used) {
-  const double span = next.endTime() - next.startTime();  // spliceTrajectory's longest blend
-  double blend = std::min(std::max(blend_s, 0.0), span);
-  SetpointTrajectory spliced = spliceTrajectory(current, next, t_switch, blend);
-  while (blend > 0.0 && blend < span && 2.0 * blend <= max_blend_s + 1e-9) {
-    // What the two trajectories command themselves over the blend is no fault of the blend's.
-    const double own = std::max(peakAcceleration(current, t_switch, t_switch + blend),
-                                peakAcceleration(next, next.startTime(), next.startTime() + blend));
-    if (peakAcceleration(spliced, t_switch, t_switch + blend) <= std::max(max_accel, own) + 1e-9) break;
-    blend = std::min(2.0 * blend, span);
-    spliced = spliceTrajectory(current, next, t_switch, blend);
-  }
-  if (blend_used != nullptr) *blend_used = blend;
-  return spliced;
-}
-
 }  // namespace tgnav::control

@@ -34,18 +34,4 @@ class SetpointTrajectory {
 SetpointTrajectory spliceTrajectory(const SetpointTrajectory& current, const SetpointTrajectory& next, double t_switch,
                                     double blend_s);
 
-// The largest acceleration (norm) of `trajectory`'s setpoints at times in [from_s, to_s].
-double peakAcceleration(const SetpointTrajectory& trajectory, double from_s, double to_s);
-
-// spliceTrajectory with the blend doubled from `blend_s` (up to `max_blend_s`) until the blend
-// commands no acceleration beyond `max_accel`, or beyond the larger of the two trajectories'
-// own peaks over the blend where those exceed it. A blend into a trajectory that starts at rest
-// brakes by up to 2 x 1.875 / blend_s times the speed, and adds up to 5.8 / blend_s^2 times the
-// gap between the two trajectories: over 1 s it commanded 1.75-2.96 m/s^2 where the trajectories
-// keep 1 m/s^2 (online trials, docs/results/online10). `blend_used`, if given, gets the blend's
-// length (0 without one).
-SetpointTrajectory spliceWithinAccel(const SetpointTrajectory& current, const SetpointTrajectory& next, double t_switch,
-                                     double blend_s, double max_accel, double max_blend_s,
-                                     double* blend_used = nullptr);
-
 }  // namespace tgnav::control

@@ -25,9 +25,6 @@ constexpr double kBlockedStepS = 0.1;
 // follows the current route: it is not flown (a switch starts from rest). Yaw is not compared:
 // where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
 constexpr double kSameRouteM = 0.75;
-// A switch's blend may be lengthened up to this many times trial.blend_s to keep the acceleration
-// limit (control::spliceWithinAccel).
-constexpr double kMaxBlendFactor = 4.0;
 
 MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   MapBuildConfig config;
@@ -314,20 +311,13 @@ void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   }
   if (tt.size() < 3) return;
   smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
-  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s,
-           false);
+  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
 }
 
-void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s, bool urgent) {
-  // The blend is lengthened (up to kMaxBlendFactor times) until it keeps the trajectories'
-  // acceleration limit, unless the path ahead is blocked: a longer blend would fly on towards the
-  // obstacle for longer (seen: two collisions on storage with the vehicle 0.5-1 s into a
-  // lengthened blend away from a blocked path).
-  const planner::TrajectoryConfig& limits = scenario_.planner.trajectory;
-  const double longest = urgent ? blend_s : kMaxBlendFactor * blend_s;
+void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
   current_ = std::make_unique<control::SetpointTrajectory>(
-      limitYawRate(control::spliceWithinAccel(*current_, next, tau_switch, blend_s, limits.max_accel_mps2, longest),
-                   tau_switch, limits.max_yaw_rate_rad_s));
+      limitYawRate(control::spliceTrajectory(*current_, next, tau_switch, blend_s), tau_switch,
+                   scenario_.planner.trajectory.max_yaw_rate_rad_s));
 }
 
 void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s) {
@@ -391,7 +381,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
     last_change_s_ = t_s;
-    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s, a.record.trigger == "blocked");
+    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
     pending_until_s_ = t_eff;
     failed_in_a_row_ = 0;
     holding_ = false;
@@ -407,11 +397,10 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     why << failed_in_a_row_ << " plans in a row found no route (last: " << a.record.detail << ")";
     return why.str();
   }
-  const bool blocked = blockedAhead(tau_now);
-  if (spent || blocked) {
+  if (spent || blockedAhead(tau_now)) {
     // Stop where the current trajectory is at the switch, and wait for a route.
     switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s), tau_switch,
-             before_start ? 0.0 : cfg_.blend_s, blocked);
+             before_start ? 0.0 : cfg_.blend_s);
     holding_ = true;
     pending_until_s_ = t_eff;
   }

@@ -122,11 +122,9 @@ class OnlinePlanning {
   bool goalObserved() const;
   bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
   void renewViews(const Attempt& a, double tau_switch);
-  // The current trajectory becomes `next` from tau_switch on (spliceWithinAccel: a blend of
-  // blend_s, lengthened up to kMaxBlendFactor times to keep the acceleration limit unless `urgent`,
-  // the path ahead being blocked), its yaw rate then held within the trajectory's limit
-  // (limitYawRate).
-  void switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s, bool urgent);
+  // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
+  // then held within the trajectory's limit (limitYawRate).
+  void switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s);
   // The look-ahead rule on `trajectory`, planned on `map` (and `voxels`, its planners' voxel map).
   control::SetpointTrajectory lookAhead(const control::SetpointTrajectory& trajectory, const planner::FeatureMap& map,
                                         const planner::VoxelMap& voxels) const;
