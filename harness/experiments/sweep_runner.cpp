@@ -119,8 +119,9 @@ std::vector<std::pair<fs::path, fs::path>> snapshotScenarios(const SweepDir& dir
     if (it == held.end()) {
       const std::string stem = t.scenario.stem().string();
       fs::path to = folder / (stem + ".yaml");
-      for (int n = 2; taken.count(to) != 0 || fs::exists(to); ++n)
+      for (int n = 2; taken.count(to) != 0 || fs::exists(to); ++n) {
         to = folder / (stem + "-" + std::to_string(n) + ".yaml");
+      }
       taken.insert(to);
       to_write.emplace_back(t.scenario, to);
       it = held.emplace(t.scenario, to).first;

@@ -477,8 +477,9 @@ TEST(StateEstimator, GyroBiasIsLearntWhenItsGainIsPositive) {
       if (k % kStepsPerFrame == 0) {
         EXPECT_TRUE(est.fusePose(t - kLatency, pose(Flight::p(t - kLatency), Flight::q(t - kLatency))));
       }
-      if (t > 20.0)
+      if (t > 20.0) {
         max_late_attitude_error = std::max(max_late_attitude_error, est.state().q_WB.angularDistance(Flight::q(t)));
+      }
     }
     *rate_error = est.state().w_B - Flight::imu(est.time(), kDt).w_B;
     return max_late_attitude_error;

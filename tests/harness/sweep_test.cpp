@@ -149,8 +149,9 @@ TEST(Sweep, TrackModelIsAFileRelativeToTheSweep) {
 TEST(Sweep, VehicleAxisIsAFileRelativeToTheSweepNamedByItsStem) {
   const fs::path dir = test::tempDir();
   const std::string hex = (test::sourceDir() / "models/vehicles/hexarotor.yaml").string();
-  for (const char* f : {"hexarotor.xml", "hexarotor_gains.yaml"})
+  for (const char* f : {"hexarotor.xml", "hexarotor_gains.yaml"}) {
     fs::copy_file(test::sourceDir() / "models/vehicles" / f, dir / f);
+  }
   fs::copy_file(hex, dir / "hexcopy.yaml");
   const Sweep s = loadSweep(sweepFile(dir,
                                       "seeds: [1]\nruns:\n  - {scenario: SC/smoke.yaml, planner: proposed, axes: "
@@ -336,9 +337,10 @@ TEST(SweepFolder, IndexHasEachFinishedTrialOnceInManifestOrder) {
     t.id = "smoke__rrtstar-300__s0" + std::to_string(seed);
     const fs::path f = dir / t.id;
     fs::create_directories(f);
-    if (seed != 2)
+    if (seed != 2) {
       test::writeFile(f / "metrics.json", metricsJson(seed == 3 ? "vo_lost" : "success", seed == 3 ? "null" : "0.05",
                                                       std::to_string(seed)));
+    }
     trials.push_back(t);
     folders.push_back(inspectTrialFolder(t, f));
   }
@@ -409,6 +411,10 @@ std::vector<std::string> indexIds(const fs::path& out) {
 struct ScopedEnv {
   ScopedEnv(const char* n, const std::string& v) : name(n), old(getenv(n) ? getenv(n) : "") { setenv(n, v.c_str(), 1); }
   ~ScopedEnv() { old.empty() ? unsetenv(name) : setenv(name, old.c_str(), 1); }
+  ScopedEnv(const ScopedEnv&) = delete;
+  ScopedEnv& operator=(const ScopedEnv&) = delete;
+  ScopedEnv(ScopedEnv&&) = delete;
+  ScopedEnv& operator=(ScopedEnv&&) = delete;
   const char* name;
   std::string old;
 };
