@@ -96,7 +96,7 @@ void StateEstimator::propagate(const ImuSample& imu) {
 
   // Discrete white acceleration, sigma per sample: G = [dt^2/2 I; dt I; 0], Q = G G^T sigma^2, and
   // the bias's random walk, walk^2 dt.
-  Eigen::Matrix<double, 9, 3> G = Eigen::Matrix<double, 9, 3>::Zero();
+  Eigen::Matrix<double, 9, 3> G;
   G << 0.5 * dt * dt * Eigen::Matrix3d::Identity(), dt * Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Zero();
   const Matrix9d F = transition(dt);
   x_ = F * x_ + G * a_W;

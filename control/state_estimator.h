@@ -93,10 +93,8 @@ class StateEstimator {
 
   VehicleState state() const;
   double time() const { return t_s_; }
-  // Covariance of [p_WB; v_WB] (covarianceWithBias: of [p_WB; v_WB; b_W]).
-  Eigen::Matrix<double, 6, 6> covariance() const { return P_.topLeftCorner<6, 6>(); }
-  const Eigen::Matrix<double, 9, 9>& covarianceWithBias() const { return P_; }
-  Eigen::Vector3d accelBias() const { return x_.tail<3>(); }  // b_W
+  Eigen::Matrix<double, 6, 6> covariance() const { return P_.topLeftCorner<6, 6>(); }  // of [p_WB; v_WB]
+  Eigen::Vector3d accelBias() const { return x_.tail<3>(); }                           // b_W
   int fused() const { return fused_; }
   int rejected() const { return rejected_; }
 

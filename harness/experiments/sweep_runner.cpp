@@ -91,13 +91,13 @@ void prebuildMaps(const SweepRun& run) {
 constexpr const char* kSnapshotPrefix = "# tgnav sweep: the resolved scenario of ";
 constexpr const char* kSnapshotSuffix = ", as the sweep first ran";
 
-// Points every trial at a snapshot of its scenario in DIR/scenarios/, so that editing configs/
-// under a running or stopped sweep changes none of its trials; returns the snapshots still to
-// write (scenario, snapshot), which writeSnapshots() writes once the folder is known to hold this
-// sweep. A folder made before snapshots (its commands.txt names no DIR/scenarios/) keeps its
-// trials' scenarios as they are.
-std::vector<std::pair<fs::path, fs::path>> snapshotScenarios(const SweepDir& dir, Sweep* sweep) {
-  const fs::path folder = fs::absolute(dir.path()).lexically_normal() / "scenarios";
+// Points every trial at a snapshot of its scenario in `folder` (DIR/scenarios/, absolute), so that
+// editing configs/ under a running or stopped sweep changes none of its trials; returns the
+// snapshots still to write (scenario, snapshot), which writeSnapshots() writes once the folder is
+// known to hold this sweep. A folder made before snapshots (its commands.txt names no
+// DIR/scenarios/) keeps its trials' scenarios as they are.
+std::vector<std::pair<fs::path, fs::path>> snapshotScenarios(const SweepDir& dir, const fs::path& folder,
+                                                             Sweep* sweep) {
   const fs::path commands = dir.path() / "commands.txt";
   if (fs::exists(commands) && readTextFile(commands).find(folder.string() + "/") == std::string::npos) return {};
   std::map<fs::path, fs::path> held;  // scenario -> its snapshot, from the snapshots' first lines
@@ -167,9 +167,10 @@ int runSweep(const SweepOptions& opt) {
   const FolderLock lock(dir.path() / ".lock", /*inherit=*/true, 120.0,
                         "tgnav sweep: " + dir.path().string() +
                             " is locked (another sweep, or the trials of a killed one still stopping); waiting...");
-  const std::vector<std::pair<fs::path, fs::path>> snapshots = snapshotScenarios(dir, &sweep);
+  const fs::path snapshot_dir = fs::absolute(dir.path()).lexically_normal() / "scenarios";
+  const std::vector<std::pair<fs::path, fs::path>> snapshots = snapshotScenarios(dir, snapshot_dir, &sweep);
   dir.prepare(sweep);
-  writeSnapshots(fs::absolute(dir.path()).lexically_normal() / "scenarios", snapshots);
+  writeSnapshots(snapshot_dir, snapshots);
   refuseWhileSlurmRuns(dir);
   SweepRun run = planRun(dir, sweep);
   if (run.todo.empty()) {
