@@ -13,7 +13,19 @@
 
 namespace tgnav::harness {
 
+// The planners' default robot radius in the harness: it bounds the vehicle it flies. The propeller
+// discs of models/quadrotor.xml reach 0.372 m from the body origin at any attitude
+// (tests/harness/vehicle_test.cpp checks it), so 0.38 m, that rounded up to the centimetre. The
+// planner library's own default, 0.3 m, is for a smaller robot. A scene flown by another vehicle
+// sets planner.robot_radius_m to that vehicle's bound (harness::vehicleReach).
+inline constexpr double kVehicleRobotRadiusM = 0.38;
+
 struct PlannerSettings {
+  PlannerSettings() {
+    perception.robot_radius_m = kVehicleRobotRadiusM;
+    shareFromPerception();
+  }
+
   planner::PerceptionPlannerConfig perception;  // proposed and agnostic
   planner::RrtStarConfig rrt_star;              // its robot radius, visibility, information and
                                                 // labelling classes follow `perception`'s (one

@@ -1,5 +1,6 @@
 #include "harness/run/external_plan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -114,8 +115,11 @@ PlanRequestMessage prepareRequest(const Scenario& scenario, const fs::path& map_
                                   std::uint64_t seed, const fs::path& tmp, ExternalPlan* out) {
   const ExternalPlannerConfig& ext = scenario.planner.external;
   const auto t0 = Clock::now();
+  // The band above the floor's own voxel layer: where the band reaches down to it (a robot radius
+  // of 0.38 m does at a 1 m flight height), the floor would block every cell of the slice.
   const ClearanceBand band = clearanceBand(scenario);
-  writeRosMap(voxels.slice(band.lo_m, band.hi_m), tmp / "occupancy.yaml", tmp / "occupancy.pgm");
+  const double lo_m = std::max(band.lo_m, scenario.scene.bounds_min_m.z() + 1.5 * voxels.resolution());
+  writeRosMap(voxels.slice(lo_m, band.hi_m), tmp / "occupancy.yaml", tmp / "occupancy.pgm");
   if (ext.classes) out->topo = writeClasses(scenario, voxels, seed, tmp / "classes.json");
   PlanRequestMessage request = requestFor(scenario, map_dir, tmp, seed, ext.classes);
   out->prepare_s = secondsSince(t0);

@@ -228,6 +228,16 @@ void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const pl
 
 double vehicleMass(const mjModel* m, const VehicleIds& ids) { return m->body_subtreemass[ids.body]; }
 
+double vehicleReach(const mjModel* m, const VehicleIds& ids) {
+  double reach = 0.0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] != ids.body || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;
+    const mjtNum* p = m->geom_pos + 3 * static_cast<std::ptrdiff_t>(g);
+    reach = std::max(reach, std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) + m->geom_rbound[g]);
+  }
+  return reach;
+}
+
 control::VehicleParams vehicleParamsFromModel(const mjModel* m, const VehicleIds& ids) {
   control::VehicleParams v;
   v.mass_kg = vehicleMass(m, ids);

@@ -63,6 +63,11 @@ void setVehiclePose(const mjModel* m, mjData* d, const VehicleIds& ids, const pl
 // Total mass of the vehicle's body subtree in kg.
 double vehicleMass(const mjModel* m, const VehicleIds& ids);
 
+// How far the vehicle's collision geometry reaches from its body origin, at any attitude: the
+// largest |geom position| + bounding-sphere radius over the collision geoms of its body. A planner's
+// robot radius below it lets the vehicle touch what its paths clear.
+double vehicleReach(const mjModel* m, const VehicleIds& ids);
+
 // Mass, inertia and rotor geometry as the model defines them: rotor positions from the
 // actuator sites (relative to the centre of mass), thrust axes and yaw-moment ratios from the
 // actuator gears, maximum thrust from the control ranges (or the description), motor lag from

@@ -12,6 +12,7 @@
 
 #include "control/allocator.h"
 #include "harness/base/files.h"
+#include "harness/config/planner_config.h"
 #include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
 #include "harness/run/map_cache.h"
@@ -76,6 +77,20 @@ TEST(VehicleDescription, ShippedAirframesLoadWithTheirRotorCounts) {
     EXPECT_EQ(p.rotors.size(), rotors) << file;
     EXPECT_LT(p.hoverThrust(), 0.6) << file;
   }
+}
+
+TEST(VehicleModel, ThePlannersDefaultRobotRadiusBoundsTheDefaultVehicle) {
+  // The propeller discs (radius 0.12 m, 0.25 m out along the arms, 0.03 m up) reach 0.372 m.
+  const VehicleModel own = loadVehicleModel(emptyScene());
+  const double reach = vehicleReach(own.model.get(), own.ids);
+  EXPECT_NEAR(reach, std::hypot(0.177 * std::sqrt(2.0), 0.03) + std::hypot(0.12, 0.005), 1e-6);
+  const PlannerSettings defaults;
+  EXPECT_GE(defaults.perception.robot_radius_m, reach);
+  EXPECT_EQ(defaults.rrt_star.robot_radius_m, defaults.perception.robot_radius_m);
+  EXPECT_EQ(defaults.trajectory.robot_radius_m, defaults.perception.robot_radius_m);
+  // The shipped planner.yaml says the same.
+  EXPECT_EQ(loadPlannerSettings(src("configs/planner.yaml")).perception.robot_radius_m,
+            defaults.perception.robot_radius_m);
 }
 
 TEST(VehicleModel, TheSameSceneFlownByAnotherAirframe) {

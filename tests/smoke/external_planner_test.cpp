@@ -103,7 +103,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadPlanner{"version2", "protocol version 2, expected 1"},
                       BadPlanner{"nan", "invalid response: not JSON (NaN and Infinity are not JSON numbers)"},
                       BadPlanner{"wall", "route refused: path: waypoint 2 at"},
-                      BadPlanner{"line", "closer than the robot radius 0.3 m"},
+                      BadPlanner{"line", "closer than the robot radius 0.38 m"},
                       BadPlanner{"oob", "is outside the scene's bounds"},
                       BadPlanner{"one", "invalid response: 'path' has 1 points, at least 2 needed"},
                       BadPlanner{"million", "invalid response: 'path' has 1000000 points, at most 100000 allowed"},

@@ -123,7 +123,8 @@ TEST_P(SmokeFlight, ReachesTheGoalWithVoTracking) {
   EXPECT_EQ(m["planner"], planner);
   EXPECT_EQ(m["camera"]["width_px"], 320);
   EXPECT_TRUE(m["vo_lost_at_s"].is_null());
-  EXPECT_LT(m["ate_rmse_m"].get<double>(), 0.05);
+  // Within the drift bound of a success (trial.max_drift_ratio, 1 %) of the distance flown.
+  EXPECT_LT(m["ate_rmse_m"].get<double>(), 0.01 * m["path_length_m"].get<double>());
   ASSERT_FALSE(m["goal_error_m"].is_null());
   EXPECT_LT(m["goal_error_m"].get<double>(), 0.15);
   EXPECT_LT(m["final_distance_to_goal_m"].get<double>(), 0.1);
@@ -134,8 +135,8 @@ TEST_P(SmokeFlight, ReachesTheGoalWithVoTracking) {
 // RRT*'s path depends on its seed and on the feature map: on the map rendered without
 // multisampling, seeds 1, 2 and 6 turn the camera to a plain wall and the VO loses track there (a
 // real outcome, which the trial reports as vo_lost, with or without multisampling in the trial's
-// own camera); seeds 3, 4 and 5 stay in view of texture. This test is about the RRT* trial
-// reaching the goal, so it flies seed 3.
+// own camera); seed 3 stays in view of texture (seeds 4 and 5 did too at a robot radius of 0.3 m,
+// and lose track at 0.38 m). This test is about the RRT* trial reaching the goal, so it flies seed 3.
 INSTANTIATE_TEST_SUITE_P(Planners, SmokeFlight,
                          ::testing::Values(Flight{"proposed", 1}, Flight{"agnostic", 1}, Flight{"rrtstar", 3}),
                          [](const auto& info) { return info.param.planner; });
@@ -324,7 +325,7 @@ TEST(SmokeTrialCli, GivenTrajectoryThroughAWallOrAwayFromTheStartIsRefused) {
   // The smoke scene: start (-3, 0, 1), goal (3, 0, 1), a pillar in between, bounds x +-4, y +-3.
   const std::string through = write("through.csv", "0,-3,0,1,0\n10,3,0,1,0\n");
   const std::string away = write("away.csv", "0,-2,0,1,0\n10,3,0,1,0\n");
-  const std::string outside = write("outside.csv", "0,-3,0,1,0\n5,-3,-2.5,1,0\n10,-3,-3.5,1,0\n");
+  const std::string outside = write("outside.csv", "0,-3,0,1,0\n5,-3,-2.3,1,0\n10,-3,-3.5,1,0\n");
   const std::string nan = write("nan.csv", "0,-3,0,1,0\n10,nan,0,1,0\n");
   const auto out = dir / "trial";
   const std::vector<std::pair<std::string, std::string>> cases = {
