@@ -355,6 +355,29 @@ bool VoxelMap::segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   return true;
 }
 
+std::optional<Eigen::Vector3d> VoxelMap::nearestClear(const Eigen::Vector3d& p_W, double clearance_m,
+                                                      double max_distance_m) const {
+  if (clearance(p_W) >= clearance_m) return p_W;
+  constexpr int kDirections = 64;
+  const double step = 0.25 * res_;
+  for (int ring = 1; ring * step <= max_distance_m + 1e-9; ++ring) {
+    const double d = ring * step;
+    std::optional<Eigen::Vector3d> best;
+    double best_clearance = clearance_m;
+    for (int k = 0; k < kDirections; ++k) {
+      const double a = 2.0 * M_PI * k / kDirections;
+      const Eigen::Vector3d q = p_W + d * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0);
+      const double c = clearance(q);
+      if (c >= best_clearance && (!best || c > best_clearance)) {
+        best = q;
+        best_clearance = c;
+      }
+    }
+    if (best) return best;
+  }
+  return std::nullopt;
+}
+
 OccupancyGrid2D VoxelMap::slice(double z_lo, double z_hi) const {
   OccupancyGrid2D grid(size_.x(), size_.y(), res_, origin_.head<2>());
   const int z0 = std::max(0, cellOf(Eigen::Vector3d(origin_.x(), origin_.y(), z_lo)).z());

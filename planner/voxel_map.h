@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "planner/feature_map.h"
@@ -82,6 +83,12 @@ class VoxelMap {
   // Every point of the segment keeps `clearance_m` (rigorous: sampled densely enough that
   // the 1-Lipschitz clearance cannot dip between samples).
   bool segmentClear(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double clearance_m) const;
+  // The nearest point to p at p's height, at most `max_distance_m` from it, whose clearance() is at
+  // least `clearance_m`: p itself if it has it, else the clearest of 64 directions on the nearest
+  // ring (rings a quarter voxel apart) that has one (the first from +x counter-clockwise on ties).
+  // nullopt if none does. Where a vehicle that flew too close to an obstacle can plan from.
+  std::optional<Eigen::Vector3d> nearestClear(const Eigen::Vector3d& p_W, double clearance_m,
+                                              double max_distance_m) const;
   // How much more than `clearance_m` segmentClear may ask of a point (its samples' half spacing):
   // paths planned on a slice keep this margin (TopoPlannerConfig::path_margin_m) so that the
   // check passes them.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "harness/base/clock.h"
@@ -198,6 +199,24 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   return a;
 }
 
+OnlinePlanning::Attempt OnlinePlanning::planClearOf(const planner::Pose4& start, double t_s,
+                                                    const std::string& trigger) {
+  Attempt a = plan(start, t_s, trigger);
+  if (a.record.ok || external_ || a.run.plan.status != planner::PlanStatus::kInvalidStart || !a.run.voxels) return a;
+  // The vehicle came within the robot radius of what the map now holds: plan from the nearest point
+  // that clears it (two voxels more, for the planners' own discretised checks), no further away than
+  // the radius itself; the blend into the new trajectory steps away.
+  const double r = scenario_.planner.perception.robot_radius_m;
+  const double res = a.run.voxels->resolution();
+  const std::optional<Eigen::Vector3d> out = a.run.voxels->nearestClear(start.p_WB, r + 2.0 * res, r);
+  if (!out) return a;
+  planner::Pose4 moved = start;
+  moved.p_WB = *out;
+  Attempt b = plan(moved, t_s, trigger);
+  b.record.start_shift_m = (*out - start.p_WB).norm();
+  return b;
+}
+
 bool OnlinePlanning::askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a) {
   a->run.planner = planner_;
   a->run.seed = seed_;
@@ -355,7 +374,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     blocked_ = false;
     return std::string();
   }
-  Attempt a = plan(start, t_s, blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period");
+  Attempt a = planClearOf(start, t_s, blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period");
   next_replan_s_ = t_s + cfg_.replan_period_s;
   blocked_ = false;
   goal_event_ = false;

@@ -46,8 +46,12 @@ struct OnlinePlan {
   // trajectory's positions are kept and its yaw ahead becomes the new plan's at the nearest point
   // (then the look-ahead rule on the current map), blended in over trial.blend_s.
   bool views_renewed = false;
-  std::string detail;                 // why not, when it failed
-  planner::Pose4 start;               // where it starts (the estimated frame)
+  std::string detail;    // why not, when it failed
+  planner::Pose4 start;  // where it starts (the estimated frame)
+  // > 0: the point on the current trajectory where it would have started lay within the robot
+  // radius of a mapped obstacle (the vehicle had come that close), and it started this far from
+  // there instead, at the nearest point that clears it (the blend into it steps away)
+  double start_shift_m = 0.0;
   std::vector<Eigen::Vector3d> path;  // its chosen path
   std::vector<bool> path_unknown;     // per point of `path`: never observed when planned
   int chosen_class = -1;
@@ -117,6 +121,9 @@ class OnlinePlanning {
  private:
   struct Attempt;
   Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
+  // plan(), and where a built-in planner finds `start` within the robot radius of the map
+  // (`invalid_start`), plan() again from the nearest point that clears it (record.start_shift_m).
+  Attempt planClearOf(const planner::Pose4& start, double t_s, const std::string& trigger);
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
   bool goalObserved() const;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -216,6 +217,25 @@ TEST(VoxelMapUnknownSpace, UnknownBlocksByDefaultAndIsFreeWhenAsked) {
   EXPECT_GT(optimistic.clearance(unseen), 0.5);
   EXPECT_EQ(optimistic.state(wall), VoxelState::kOccupied);
   EXPECT_EQ(optimistic.clearance(wall), 0.0);
+}
+
+// A vehicle that came too close to a wall plans from the nearest point that clears it.
+TEST(VoxelMapNearestClear, StepsStraightAwayFromTheNearestObstacle) {
+  FeatureMap map(kRes);
+  fillBox(map.occupancy(), {-0.1, -2.0, 0.0}, {0.1, 2.0, 2.5});  // a wall: its west face at x = -0.1
+  const VoxelMap voxels(map, Eigen::Vector3d(-4, -4, 0), Eigen::Vector3d(4, 4, 3));
+  const Eigen::Vector3d near(-0.3, 0.05, 1.05);  // 0.2 m from the face
+  EXPECT_NEAR(voxels.clearance(near), 0.2, 1e-9);
+  const std::optional<Eigen::Vector3d> out = voxels.nearestClear(near, 0.4, 0.4);
+  ASSERT_TRUE(out.has_value());
+  EXPECT_GE(voxels.clearance(*out), 0.4);
+  EXPECT_NEAR(out->x(), -0.5, 0.03);  // straight west, on the nearest ring (a quarter voxel apart) that clears it
+  EXPECT_NEAR(out->y(), near.y(), 1e-6);
+  EXPECT_EQ(out->z(), near.z());
+  // A point that already clears it is its own answer; one too deep for the distance allowed has none.
+  EXPECT_EQ(voxels.nearestClear(*out, 0.4, 0.4), out);
+  EXPECT_FALSE(voxels.nearestClear(near, 0.4, 0.15).has_value());
+  EXPECT_FALSE(voxels.nearestClear(Eigen::Vector3d(0.0, 0.05, 1.05), 0.4, 0.3).has_value());  // in the wall
 }
 
 TEST(Detectability, ObservationsOutOfOpportunitiesAtMostOne) {
