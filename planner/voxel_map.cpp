@@ -363,12 +363,12 @@ std::optional<Eigen::Vector3d> VoxelMap::nearestClear(const Eigen::Vector3d& p_W
   for (int ring = 1; ring * step <= max_distance_m + 1e-9; ++ring) {
     const double d = ring * step;
     std::optional<Eigen::Vector3d> best;
-    double best_clearance = clearance_m;
+    double best_clearance = -std::numeric_limits<double>::infinity();
     for (int k = 0; k < kDirections; ++k) {
       const double a = 2.0 * M_PI * k / kDirections;
       const Eigen::Vector3d q = p_W + d * Eigen::Vector3d(std::cos(a), std::sin(a), 0.0);
       const double c = clearance(q);
-      if (c >= best_clearance && (!best || c > best_clearance)) {
+      if (c >= clearance_m && c > best_clearance) {
         best = q;
         best_clearance = c;
       }
