@@ -307,6 +307,7 @@ TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, cons
     applyOracleClass(*job.homology_class, job.planner, &scenario);
     options.oracle_option = "--class";
   }
+  checkRobotRadiusBoundsVehicle(scenario);
   checkOutput(job.out, job.force);
   StagedDir staged(job.out);
   const planner::FeatureMap map =

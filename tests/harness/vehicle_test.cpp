@@ -16,6 +16,7 @@
 #include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
 #include "harness/run/map_cache.h"
+#include "harness/run/trial.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/vehicle_model.h"
@@ -91,6 +92,24 @@ TEST(VehicleModel, ThePlannersDefaultRobotRadiusBoundsTheDefaultVehicle) {
   // The shipped planner.yaml says the same.
   EXPECT_EQ(loadPlannerSettings(src("configs/planner.yaml")).perception.robot_radius_m,
             defaults.perception.robot_radius_m);
+}
+
+TEST(VehicleModel, ATrialRefusesARobotRadiusLessThanTheVehiclesReach) {
+  // The hexarotor's rotor discs reach about 0.404 m, beyond the default 0.38 m: its trial is refused
+  // before any map is built, with the radius it needs; at that radius it may fly. The default
+  // vehicle flies at the default.
+  const fs::path smoke = src("configs/scenarios/smoke.yaml");
+  EXPECT_NO_THROW(checkRobotRadiusBoundsVehicle(loadScenario(smoke)));
+  const YamlDoc hex = YamlDoc::fromOverrides({"vehicle=" + src("models/vehicles/hexarotor.yaml").string()});
+  const Scenario scenario = loadScenario(smoke, &hex);
+  const std::string msg = test::inputError([&] { checkRobotRadiusBoundsVehicle(scenario); });
+  expectOneLine(msg);
+  for (const char* part : {"smoke.yaml", "planner.robot_radius_m = 0.38", "hexarotor.yaml (0.40", "at least 0.41"}) {
+    EXPECT_NE(msg.find(part), std::string::npos) << part << " in: " << msg;
+  }
+  const YamlDoc wider = YamlDoc::fromOverrides(
+      {"vehicle=" + src("models/vehicles/hexarotor.yaml").string(), "planner.robot_radius_m=0.41"});
+  EXPECT_NO_THROW(checkRobotRadiusBoundsVehicle(loadScenario(smoke, &wider)));
 }
 
 TEST(VehicleModel, TheSameSceneFlownByAnotherAirframe) {
