@@ -88,6 +88,10 @@ struct OnlineConfig {
   // ahead is blocked or the vehicle holds): the vehicle commits to a route long enough to look at
   // it, instead of dithering between two whose unknown parts both look free.
   double commit_s = 6.0;
+  // A plan whose choice the proposed planner rates blind for shorter than the current route's class
+  // on the same map (by more than planner.selection.blind_tolerance_m) is flown at once, whatever
+  // commit_s says: the predicted visibility of the route ahead has dropped.
+  bool leave_blind_route = false;
   // Where the trajectory this far ahead runs through space unknown when planned (or everywhere,
   // with look_ahead_always), the camera turns from the planner's yaw as little as keeps the way
   // there in view (look before flying there); 0: the planner's yaw everywhere.
@@ -131,6 +135,7 @@ struct OnlineConfig {
     a("replan_period_s", replan_period_s);
     a("blend_s", blend_s);
     a("commit_s", commit_s);
+    a("leave_blind_route", leave_blind_route);
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
     a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);

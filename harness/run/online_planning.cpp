@@ -304,6 +304,23 @@ bool OnlinePlanning::sameRoute(const std::vector<planner::Pose4>& path, double t
   return true;
 }
 
+bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
+  return plan.chosen_blind_m >= 0.0 && plan.route_blind_m >= 0.0 &&
+         plan.chosen_blind_m + tolerance_m < plan.route_blind_m;
+}
+
+void OnlinePlanning::rateRouteBlindness(double tau_from, Attempt* a) const {
+  const planner::Plan& plan = a->run.plan;
+  if (plan.chosen < 0 || plan.chosen >= static_cast<int>(plan.candidates.size())) return;
+  a->record.chosen_blind_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].blind_length_m;
+  for (const planner::CandidatePath& c : plan.candidates) {
+    if (c.feasible && !c.path.empty() && sameRoute(c.path, tau_from)) {
+      a->record.route_blind_m = c.blind_length_m;
+      return;
+    }
+  }
+}
+
 void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   const std::vector<double>& t = current_->times();
   const std::vector<control::TrajectorySetpoint>& from = a.raw->setpoints();
@@ -381,8 +398,14 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
   // to this one.
   const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
-  const bool must_switch = holding_ || stopping || a.record.trigger == "blocked";
-  const bool committed = t_s < last_change_s_ + cfg_.commit_s;
+  if (a.trajectory && !before_start) rateRouteBlindness(tau_switch, &a);
+  // A plan that rates the current route blind for longer than its choice leaves it at once.
+  const bool leave_blind =
+      cfg_.leave_blind_route && leavesBlindRoute(a.record, scenario_.planner.perception.selection.blind_tolerance_m);
+  const bool must_switch = holding_ || stopping || a.record.trigger == "blocked" || leave_blind;
+  // (Plans come every replan_period_s of accumulated simulated time: one commit_s after the last
+  // change is not committed, whatever the rounding.)
+  const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
   // Whether the plan follows the current route: asked only where it decides something.
   const bool same = a.trajectory && !before_start && !must_switch && (!committed || cfg_.renew_views) &&
                     sameRoute(a.run.plan.path, tau_switch);

@@ -55,6 +55,12 @@ struct OnlinePlan {
   std::vector<Eigen::Vector3d> path;  // its chosen path
   std::vector<bool> path_unknown;     // per point of `path`: never observed when planned
   int chosen_class = -1;
+  // The blind length (planner::CandidatePath::blind_length_m; only the proposed planner rates it,
+  // the others give 0) of its choice, and of its candidate that follows the current route (that
+  // route's class on this plan's map); -1: not asked (before take-off, or no route to follow) or no
+  // candidate follows it.
+  double chosen_blind_m = -1.0;
+  double route_blind_m = -1.0;
   int landmarks = 0;         // in the map it planned on
   int prior_landmarks = 0;   // ... and those of trial.unseen_prior added to it (unseen_prior.h)
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
@@ -76,6 +82,10 @@ struct OnlineResult {
   double unknown_share = 0.0;                 // of the flown trajectory: in space unknown when planned
   std::optional<std::string> planner_stderr;  // an external planner's: the last lines it wrote to stderr
 };
+
+// Whether a plan's choice is blind for less than its candidate along the current route by more
+// than `tolerance_m` (trial.leave_blind_route): both lengths known (>= 0).
+bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m);
 
 class OnlinePlanning {
  public:
@@ -128,6 +138,8 @@ class OnlinePlanning {
   bool blockedAhead(double tau_from) const;
   bool goalObserved() const;
   bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
+  // a.record's chosen_blind_m and route_blind_m, the route being the current one from tau_from.
+  void rateRouteBlindness(double tau_from, Attempt* a) const;
   void renewViews(const Attempt& a, double tau_switch);
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
   // then held within the trajectory's limit (limitYawRate).

@@ -208,6 +208,8 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
     j["start_shift_m"] = p.start_shift_m;
     j["chosen_class"] = p.chosen_class;
+    j["chosen_blind_m"] = p.chosen_blind_m;
+    j["route_blind_m"] = p.route_blind_m;
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();

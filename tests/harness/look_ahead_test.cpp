@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "harness/run/incremental_map.h"
+#include "harness/run/online_planning.h"
 #include "harness/run/unseen_prior.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
@@ -329,6 +330,23 @@ TEST(OccupiedWithin, MeasuresTheDistanceToTheVoxelsCubeAsThePlannersClearanceDoe
   EXPECT_TRUE(near(Eigen::Vector3d(0.55, 0.05, 1.32)));  // above it, 0.22 m
   EXPECT_TRUE(occupiedWithin(tree, {Eigen::Vector3d(-3.0, 0.0, 1.0), Eigen::Vector3d(0.55, 0.05, 0.8)}, 0.3));
   EXPECT_FALSE(occupiedWithin(tree, {}, 0.3));
+}
+
+// A plan leaves the current route at once only where its choice is blind for shorter than the
+// current route's class on the same map by more than the tolerance, and both are known.
+TEST(LeavesBlindRoute, OnlyWhenTheChoiceIsBlindForShorterByMoreThanTheTolerance) {
+  OnlinePlan p;
+  p.chosen_blind_m = 4.9;
+  p.route_blind_m = 8.0;  // storage seed 1 at 4 s: the route ahead turns past the bare shelf end
+  EXPECT_TRUE(leavesBlindRoute(p, 0.5));
+  EXPECT_FALSE(leavesBlindRoute(p, 3.1));  // within the tolerance: equal
+  p.route_blind_m = 4.9;                   // the choice is the current route
+  EXPECT_FALSE(leavesBlindRoute(p, 0.0));
+  p.route_blind_m = -1.0;  // no candidate follows the current route
+  EXPECT_FALSE(leavesBlindRoute(p, 0.5));
+  p.route_blind_m = 8.0;
+  p.chosen_blind_m = -1.0;  // not rated (before take-off)
+  EXPECT_FALSE(leavesBlindRoute(p, 0.5));
 }
 
 }  // namespace
