@@ -10,8 +10,8 @@
 #include "harness/base/clock.h"
 #include "harness/base/errors.h"
 #include "harness/run/look_ahead.h"
+#include "harness/run/online_metrics.h"
 #include "harness/run/unseen_prior.h"
-#include "harness/sim/scene_geometry.h"
 
 namespace tgnav::harness {
 
@@ -449,73 +449,18 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   return std::string();
 }
 
-namespace {
-
-// The plan in effect at time t: the last that took effect by then (the first before any).
-const OnlinePlan* planAt(const std::vector<OnlinePlan>& plans, double t_s) {
-  const OnlinePlan* in_effect = nullptr;
-  for (const OnlinePlan& p : plans) {
-    if (!p.adopted) continue;
-    if (in_effect == nullptr || p.effective_s <= t_s) in_effect = &p;
-  }
-  return in_effect;
-}
-
-}  // namespace
-
 OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,
                                     const std::vector<std::pair<double, Eigen::Vector3d>>& flown) {
   OnlineResult out = std::move(result_);
   if (external_) out.planner_stderr = external_->stderrTail();
   out.final_map = mapper_.snapshot().map;
   const octomap::OcTree& tree = out.final_map->occupancy();
-  const double res = tree.getResolution();
-  const SceneConfig& scene = scenario_.scene;
-  // Coverage: the voxels of the bounds in the flight band that were observed.
-  const ClearanceBand band = clearanceBand(scenario_);
-  long known = 0;
-  long total = 0;
-  for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
-    for (double y = scene.bounds_min_m.y() + 0.5 * res; y < scene.bounds_max_m.y(); y += res) {
-      for (double x = scene.bounds_min_m.x() + 0.5 * res; x < scene.bounds_max_m.x(); x += res) {
-        ++total;
-        known += tree.search(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)) != nullptr ? 1 : 0;
-      }
-    }
-  }
-  out.coverage = total > 0 ? static_cast<double>(known) / static_cast<double>(total) : 0.0;
-  // Map error: each occupied voxel's centre against the true surfaces.
-  const Eigen::Vector3d lo = scene.bounds_min_m - Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
-  const Eigen::Vector3d hi = scene.bounds_max_m + Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
-  double sum = 0.0;
-  long far = 0;
-  long n = 0;
-  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
-    if (!tree.isNodeOccupied(*it)) continue;
-    forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) return;
-      const double d = std::max(0.0, truth.signedDistance(p));
-      sum += d;
-      far += d > 2.0 * res ? 1 : 0;
-      ++n;
-    });
-  }
-  out.occupied_voxels = static_cast<int>(n);
-  out.map_error_mean_m = n > 0 ? sum / static_cast<double>(n) : 0.0;
-  out.map_error_far_share = n > 0 ? static_cast<double>(far) / static_cast<double>(n) : 0.0;
-  // The flight through space unknown when planned: per flown point, the nearest point of the
-  // plan in effect.
-  long unknown = 0;
-  for (const auto& [t, p] : flown) {
-    const OnlinePlan* plan = planAt(out.plans, t);
-    if (plan == nullptr || plan->path.empty()) continue;
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < plan->path.size(); ++i) {
-      if ((plan->path[i] - p).squaredNorm() < (plan->path[best] - p).squaredNorm()) best = i;
-    }
-    unknown += plan->path_unknown[best] ? 1 : 0;
-  }
-  out.unknown_share = flown.empty() ? 0.0 : static_cast<double>(unknown) / static_cast<double>(flown.size());
+  out.coverage = mapCoverage(tree, scenario_);
+  const MapError error = mapError(tree, scenario_.scene, truth);
+  out.occupied_voxels = error.occupied_voxels;
+  out.map_error_mean_m = error.mean_m;
+  out.map_error_far_share = error.far_share;
+  out.unknown_share = unknownShare(out.plans, flown);
   return out;
 }
 

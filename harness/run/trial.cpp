@@ -457,19 +457,6 @@ std::string plannerLabel(const Scenario& scenario, const TrialOptions& options) 
   return planner::toString(options.planner);
 }
 
-void checkRobotRadiusBoundsVehicle(const Scenario& scenario) {
-  const VehicleModel vehicle = loadVehicleModel(scenario.scene.mjcf, scenario.vehicle);
-  const double reach = vehicleReach(vehicle.model.get(), vehicle.ids);
-  const double radius = scenario.planner.perception.robot_radius_m;
-  if (radius >= reach) return;
-  std::ostringstream msg;
-  msg << scenario.source.string() << ": planner.robot_radius_m = " << radius
-      << " is less than the reach of the vehicle " << vehicle.vehicle.source.string() << " ("
-      << std::round(reach * 1000.0) / 1000.0 << " m from its body origin); set it to at least "
-      << std::ceil(reach * 100.0) / 100.0;
-  throw InputError(msg.str());
-}
-
 TrialResult runTrial(const Scenario& scenario, const planner::FeatureMap& map, const TrialOptions& options,
                      const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   TrialResult result;

@@ -105,11 +105,6 @@ using ProgressFn = std::function<void(const TrialProgress&)>;
 // Derived seed of stream `stream` (1: camera noise, 2: IMU) from the trial's seed.
 std::uint64_t trialSeed(std::uint64_t seed, std::uint64_t stream);
 
-// InputError naming the scenario and planner.robot_radius_m when the planners' robot radius is
-// less than the reach of the vehicle that flies (harness::vehicleReach): their clearance would not
-// keep its rotors off the obstacles.
-void checkRobotRadiusBoundsVehicle(const Scenario& scenario);
-
 // Runs the trial. `interrupt`, when set and raised, stops the flight at the next physics step
 // (status kInterrupted). Bad settings (a camera rate that does not divide the physics rate) are
 // InputErrors; expected outcomes (no path, VO lost, a crash) are statuses.

@@ -15,6 +15,8 @@
 #include "harness/io/trajectory_csv.h"
 #include "harness/run/map_cache.h"
 #include "harness/run/trial_metrics.h"
+#include "harness/sim/mujoco_sim.h"
+#include "harness/sim/vehicle_model.h"
 #include "vo/tum.h"
 
 namespace tgnav::harness {
@@ -283,6 +285,19 @@ std::string summaryLine(const Scenario& scenario, const TrialOptions& options, c
 }
 
 }  // namespace
+
+void checkRobotRadiusBoundsVehicle(const Scenario& scenario) {
+  const VehicleModel vehicle = loadVehicleModel(scenario.scene.mjcf, scenario.vehicle);
+  const double reach = vehicleReach(vehicle.model.get(), vehicle.ids);
+  const double radius = scenario.planner.perception.robot_radius_m;
+  if (radius >= reach) return;
+  std::ostringstream msg;
+  msg << scenario.source.string() << ": planner.robot_radius_m = " << radius
+      << " is less than the reach of the vehicle " << vehicle.vehicle.source.string() << " ("
+      << std::round(reach * 1000.0) / 1000.0 << " m from its body origin); set it to at least "
+      << std::ceil(reach * 100.0) / 100.0;
+  throw InputError(msg.str());
+}
 
 TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress, const std::atomic<bool>* interrupt) {
   const auto wall0 = std::chrono::steady_clock::now();

@@ -57,6 +57,11 @@ struct TrialJobResult {
   FigureOutcome figures;
 };
 
+// InputError naming the scenario and planner.robot_radius_m when the planners' robot radius is
+// less than the reach of the vehicle that flies (harness::vehicleReach): their clearance would not
+// keep its rotors off the obstacles.
+void checkRobotRadiusBoundsVehicle(const Scenario& scenario);
+
 // InputError for bad input, before anything is written. `interrupt`, when raised, stops the
 // flight; the status is then kInterrupted and the folder holds the partial results.
 TrialJobResult runTrialJob(const TrialJob& job, const ProgressFn& progress = {},

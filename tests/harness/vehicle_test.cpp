@@ -16,7 +16,7 @@
 #include "harness/config/scenario.h"
 #include "harness/config/scene_config.h"
 #include "harness/run/map_cache.h"
-#include "harness/run/trial.h"
+#include "harness/run/trial_job.h"
 #include "harness/sim/camera.h"
 #include "harness/sim/egl_context.h"
 #include "harness/sim/vehicle_model.h"
