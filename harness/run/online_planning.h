@@ -38,7 +38,8 @@ struct OnlinePlan {
   double effective_s = 0.0;  // ... and took (or would have taken) effect
   std::string trigger;       // "start" | "period" | "blocked" | "goal_seen"
   bool ok = false;
-  // Flown: it changed the route (a path ahead blocked, a hold, or, trial.commit_s after the last
+  // Flown: it changed the route (a path ahead blocked, a hold, with trial.leave_blind_route a
+  // current route rated blind for longer than its choice, or, trial.commit_s after the last
   // change, a path that leaves the current one's route by more than kSameRouteM); a plan along the
   // current route is not flown (every switch restarts from rest).
   bool adopted = false;
