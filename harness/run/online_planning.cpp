@@ -291,30 +291,39 @@ bool OnlinePlanning::blockedAhead(double tau_from) const {
   return occupiedWithin(mapper_.occupancy(), ahead, scenario_.planner.perception.robot_radius_m);
 }
 
-bool OnlinePlanning::sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const {
-  std::vector<control::TrajectorySetpoint> ahead;
+std::vector<Eigen::Vector3d> OnlinePlanning::positionsAhead(double tau_from) const {
+  std::vector<Eigen::Vector3d> ahead;
   for (double tau = tau_from; tau < current_->endTime() + kBlockedStepS; tau += kBlockedStepS) {
-    ahead.push_back(current_->sample(std::min(tau, current_->endTime())));
+    ahead.push_back(current_->sample(std::min(tau, current_->endTime())).p_WB);
   }
+  return ahead;
+}
+
+namespace {
+
+// Whether every pose of `path` lies within kSameRouteM (horizontally) of some point of `ahead`.
+bool followsRoute(const std::vector<planner::Pose4>& path, const std::vector<Eigen::Vector3d>& ahead) {
   for (const planner::Pose4& pose : path) {
     double best = std::numeric_limits<double>::infinity();
-    for (const control::TrajectorySetpoint& sp : ahead) best = std::min(best, (sp.p_WB - pose.p_WB).head<2>().norm());
+    for (const Eigen::Vector3d& p : ahead) best = std::min(best, (p - pose.p_WB).head<2>().norm());
     if (best > kSameRouteM) return false;
   }
   return true;
 }
+
+}  // namespace
 
 bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
   return plan.chosen_blind_m >= 0.0 && plan.route_blind_m >= 0.0 &&
          plan.chosen_blind_m + tolerance_m < plan.route_blind_m;
 }
 
-void OnlinePlanning::rateRouteBlindness(double tau_from, Attempt* a) const {
+void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a) {
   const planner::Plan& plan = a->run.plan;
   if (plan.chosen < 0 || plan.chosen >= static_cast<int>(plan.candidates.size())) return;
   a->record.chosen_blind_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].blind_length_m;
   for (const planner::CandidatePath& c : plan.candidates) {
-    if (c.feasible && !c.path.empty() && sameRoute(c.path, tau_from)) {
+    if (c.feasible && !c.path.empty() && followsRoute(c.path, ahead)) {
       a->record.route_blind_m = c.blind_length_m;
       return;
     }
@@ -398,17 +407,18 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
   // to this one.
   const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
-  if (a.trajectory && !before_start) rateRouteBlindness(tau_switch, &a);
+  const bool in_flight = a.trajectory && !before_start;  // its paths are compared with the route ahead
+  const std::vector<Eigen::Vector3d> ahead = in_flight ? positionsAhead(tau_switch) : std::vector<Eigen::Vector3d>{};
+  if (in_flight) rateRouteBlindness(ahead, &a);
   // A plan that rates the current route blind for longer than its choice leaves it at once.
   const bool leave_blind =
       cfg_.leave_blind_route && leavesBlindRoute(a.record, scenario_.planner.perception.selection.blind_tolerance_m);
   const bool must_switch = holding_ || stopping || a.record.trigger == "blocked" || leave_blind;
-  // (Plans come every replan_period_s of accumulated simulated time: one commit_s after the last
-  // change is not committed, whatever the rounding.)
+  // (A plan exactly commit_s after the last change is not committed, whatever the rounding.)
   const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
   // Whether the plan follows the current route: asked only where it decides something.
-  const bool same = a.trajectory && !before_start && !must_switch && (!committed || cfg_.renew_views) &&
-                    sameRoute(a.run.plan.path, tau_switch);
+  const bool same =
+      in_flight && !must_switch && (!committed || cfg_.renew_views) && followsRoute(a.run.plan.path, ahead);
   if (a.trajectory && !must_switch && (committed || same)) {
     failed_in_a_row_ = 0;
     if (cfg_.renew_views && same) {

@@ -138,9 +138,11 @@ class OnlinePlanning {
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
   bool goalObserved() const;
-  bool sameRoute(const std::vector<planner::Pose4>& path, double tau_from) const;
-  // a.record's chosen_blind_m and route_blind_m, the route being the current one from tau_from.
-  void rateRouteBlindness(double tau_from, Attempt* a) const;
+  // The current trajectory's positions from tau_from to its end, every kBlockedStepS: a plan's
+  // path follows the current route where every pose lies within kSameRouteM of them.
+  std::vector<Eigen::Vector3d> positionsAhead(double tau_from) const;
+  // a.record's chosen_blind_m and route_blind_m, the route being `ahead` (positionsAhead).
+  static void rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a);
   void renewViews(const Attempt& a, double tau_switch);
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
   // then held within the trajectory's limit (limitYawRate).
