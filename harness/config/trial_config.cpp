@@ -88,6 +88,8 @@ void OnlineConfig::validate() const {
           "replan_period_s", replan_period_s, "must be > plan_latency_s and <= 60");
   require(std::isfinite(blend_s) && blend_s >= 0.0 && blend_s <= 10.0, "blend_s", blend_s, "must be in [0, 10]");
   require(std::isfinite(commit_s) && commit_s >= 0.0 && commit_s <= 60.0, "commit_s", commit_s, "must be in [0, 60]");
+  require(std::isfinite(route_margin) && route_margin >= 0.0 && route_margin <= 10.0, "route_margin", route_margin,
+          "must be in [0, 10]");
   require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
           "must be in [0, 10]");
   if (look_ahead_best_view && look_ahead_keeps_tracking) {

@@ -92,6 +92,16 @@ struct OnlineConfig {
   // on the same map (by more than planner.selection.blind_tolerance_m) is flown at once, whatever
   // commit_s says: the predicted visibility of the route ahead has dropped.
   bool leave_blind_route = false;
+  // Hysteresis on the route (ours): once commit_s has passed, a plan that leaves the current route is
+  // flown only where it is worth a restart from rest: no candidate of the plan follows the current
+  // route (its class is gone from the map, or left more than kSameRouteM), or the route's candidate is
+  // blind for longer than the choice by more than planner.selection.blind_tolerance_m, or longer than
+  // it by more than route_margin of the choice's length. false: any other route is flown. On the
+  // survey map the vehicle otherwise changed between classes of near-equal cost every commit_s and
+  // wandered (gallery: 4/10 reached the goal, 10/10 with it); from no map it gained nothing
+  // (docs/results/keep_route).
+  bool keep_route = false;
+  double route_margin = 0.2;
   // Where the trajectory this far ahead runs through space unknown when planned (or everywhere,
   // with look_ahead_always), the camera turns from the planner's yaw as little as keeps the way
   // there in view (look before flying there); 0: the planner's yaw everywhere.
@@ -136,6 +146,8 @@ struct OnlineConfig {
     a("blend_s", blend_s);
     a("commit_s", commit_s);
     a("leave_blind_route", leave_blind_route);
+    a("keep_route", keep_route);
+    a("route_margin", route_margin);
     a("look_ahead_s", look_ahead_s);
     a("look_ahead_always", look_ahead_always);
     a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);

@@ -318,13 +318,22 @@ bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
          plan.chosen_blind_m + tolerance_m < plan.route_blind_m;
 }
 
+bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin) {
+  if (plan.route_blind_m < 0.0 || plan.chosen_blind_m < 0.0) return true;
+  return plan.chosen_blind_m + blind_tolerance_m < plan.route_blind_m ||
+         plan.route_length_m > (1.0 + margin) * plan.chosen_length_m;
+}
+
 void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a) {
   const planner::Plan& plan = a->run.plan;
   if (plan.chosen < 0 || plan.chosen >= static_cast<int>(plan.candidates.size())) return;
-  a->record.chosen_blind_m = plan.candidates[static_cast<std::size_t>(plan.chosen)].blind_length_m;
+  const planner::CandidatePath& chosen = plan.candidates[static_cast<std::size_t>(plan.chosen)];
+  a->record.chosen_blind_m = chosen.blind_length_m;
+  a->record.chosen_length_m = chosen.length_m;
   for (const planner::CandidatePath& c : plan.candidates) {
     if (c.feasible && !c.path.empty() && followsRoute(c.path, ahead)) {
       a->record.route_blind_m = c.blind_length_m;
+      a->record.route_length_m = c.length_m;
       return;
     }
   }
@@ -411,15 +420,15 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   const std::vector<Eigen::Vector3d> ahead = in_flight ? positionsAhead(tau_switch) : std::vector<Eigen::Vector3d>{};
   if (in_flight) rateRouteBlindness(ahead, &a);
   // A plan that rates the current route blind for longer than its choice leaves it at once.
-  const bool leave_blind =
-      cfg_.leave_blind_route && leavesBlindRoute(a.record, scenario_.planner.perception.selection.blind_tolerance_m);
+  const bool leave_blind = cfg_.leave_blind_route && leavesBlindRoute(a.record, blindTolerance());
   const bool must_switch = holding_ || stopping || a.record.trigger == "blocked" || leave_blind;
   // (A plan exactly commit_s after the last change is not committed, whatever the rounding.)
   const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
   // Whether the plan follows the current route: asked only where it decides something.
   const bool same =
       in_flight && !must_switch && (!committed || cfg_.renew_views) && followsRoute(a.run.plan.path, ahead);
-  if (a.trajectory && !must_switch && (committed || same)) {
+  const bool keep = cfg_.keep_route && in_flight && !worthLeavingRoute(a.record, blindTolerance(), cfg_.route_margin);
+  if (a.trajectory && !must_switch && (committed || same || keep)) {
     failed_in_a_row_ = 0;
     if (cfg_.renew_views && same) {
       renewViews(a, tau_switch);

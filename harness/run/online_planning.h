@@ -40,8 +40,9 @@ struct OnlinePlan {
   bool ok = false;
   // Flown: it changed the route (a path ahead blocked, a hold, with trial.leave_blind_route a
   // current route rated blind for longer than its choice, or, trial.commit_s after the last
-  // change, a path that leaves the current one's route by more than kSameRouteM); a plan along the
-  // current route is not flown (every switch restarts from rest).
+  // change, a path that leaves the current one's route by more than kSameRouteM, with
+  // trial.keep_route only where worthLeavingRoute); a plan along the current route is not flown
+  // (every switch restarts from rest).
   bool adopted = false;
   // A plan along the current route that was not flown still renews the views ahead: the current
   // trajectory's positions are kept and its yaw ahead becomes the new plan's at the nearest point
@@ -62,6 +63,8 @@ struct OnlinePlan {
   // candidate follows it.
   double chosen_blind_m = -1.0;
   double route_blind_m = -1.0;
+  double chosen_length_m = -1.0;  // ... and their lengths (planner::CandidatePath::length_m)
+  double route_length_m = -1.0;
   int landmarks = 0;         // in the map it planned on
   int prior_landmarks = 0;   // ... and those of trial.unseen_prior added to it (unseen_prior.h)
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
@@ -87,6 +90,12 @@ struct OnlineResult {
 // Whether a plan's choice is blind for less than its candidate along the current route by more
 // than `tolerance_m` (trial.leave_blind_route): both lengths known (>= 0).
 bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m);
+
+// Whether a plan's choice is worth leaving the current route for (trial.keep_route): no candidate
+// follows the route (route_blind_m < 0), or the route's candidate is blind for longer than the
+// choice by more than `blind_tolerance_m`, or longer than it by more than `margin` times the
+// choice's length.
+bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin);
 
 class OnlinePlanning {
  public:
@@ -143,6 +152,8 @@ class OnlinePlanning {
   std::vector<Eigen::Vector3d> positionsAhead(double tau_from) const;
   // a.record's chosen_blind_m and route_blind_m, the route being `ahead` (positionsAhead).
   static void rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a);
+  // Blind lengths this close count as equal (planner.selection.blind_tolerance_m).
+  double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }
   void renewViews(const Attempt& a, double tau_switch);
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
   // then held within the trajectory's limit (limitYawRate).

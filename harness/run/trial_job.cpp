@@ -212,6 +212,8 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["chosen_class"] = p.chosen_class;
     j["chosen_blind_m"] = p.chosen_blind_m;
     j["route_blind_m"] = p.route_blind_m;
+    j["chosen_length_m"] = p.chosen_length_m;
+    j["route_length_m"] = p.route_length_m;
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();

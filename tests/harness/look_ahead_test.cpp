@@ -349,5 +349,23 @@ TEST(LeavesBlindRoute, OnlyWhenTheChoiceIsBlindForShorterByMoreThanTheTolerance)
   EXPECT_FALSE(leavesBlindRoute(p, 0.5));
 }
 
+TEST(WorthLeavingRoute, OnlyForARouteGoneBlinderOrLongerByTheMargin) {
+  OnlinePlan p;
+  p.chosen_blind_m = 0.0;
+  p.route_blind_m = 0.2;  // gallery on the survey map: two classes, both seen textured
+  p.chosen_length_m = 20.0;
+  p.route_length_m = 21.0;
+  EXPECT_FALSE(worthLeavingRoute(p, 0.5, 0.2));  // a near tie: keep the route
+  EXPECT_TRUE(worthLeavingRoute(p, 0.1, 0.2));   // blind for longer beyond the tolerance
+  p.route_length_m = 24.5;
+  EXPECT_TRUE(worthLeavingRoute(p, 0.5, 0.2));  // longer by more than 20 %
+  EXPECT_FALSE(worthLeavingRoute(p, 0.5, 0.25));
+  p.route_blind_m = -1.0;  // no candidate follows the current route
+  EXPECT_TRUE(worthLeavingRoute(p, 0.5, 10.0));
+  p.route_blind_m = 0.2;
+  p.chosen_blind_m = -1.0;  // not rated (before take-off)
+  EXPECT_TRUE(worthLeavingRoute(p, 0.5, 10.0));
+}
+
 }  // namespace
 }  // namespace tgnav::harness
