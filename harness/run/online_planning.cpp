@@ -320,8 +320,7 @@ bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
 
 bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin) {
   if (plan.route_blind_m < 0.0 || plan.chosen_blind_m < 0.0) return true;
-  return plan.chosen_blind_m + blind_tolerance_m < plan.route_blind_m ||
-         plan.route_length_m > (1.0 + margin) * plan.chosen_length_m;
+  return leavesBlindRoute(plan, blind_tolerance_m) || plan.route_length_m > (1.0 + margin) * plan.chosen_length_m;
 }
 
 void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a) {
