@@ -96,6 +96,9 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
   }
+  require(guard_inliers >= 1 && guard_inliers <= 10000, "guard_inliers", guard_inliers, "must be in [1, 10000]");
+  require(std::isfinite(guard_range_m) && guard_range_m > 0.0 && guard_range_m <= 100.0, "guard_range_m", guard_range_m,
+          "must be in (0, 100]");
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
           "must be in [1, 100]");
   require(map_stride_px >= 1 && map_stride_px <= 64, "map_stride_px", map_stride_px, "must be in [1, 64]");

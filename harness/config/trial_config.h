@@ -126,6 +126,15 @@ struct OnlineConfig {
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, then the look-ahead rule on that map. false: the views of the plan last flown.
   bool renew_views = false;
+  // The tracking guard (harness/run/view_guard.h; the built-in planners, flying on the estimate):
+  // a frame the VO tracks with fewer than guard_inliers inliers, 10 deg or more from the last
+  // frame that tracked enough, stops the vehicle and turns the camera back there, and the plans
+  // from then on take the unknown space that turn looked toward, within guard_range_m of where it
+  // was, as occupied. guard_inliers 150 (5 times vo.min_inliers) and guard_range_m 3 were chosen,
+  // not fitted.
+  bool guard_tracking = false;
+  int guard_inliers = 150;
+  double guard_range_m = 3.0;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
   // Simulated time from take-off; beyond it the flight stops. 300 s: gallery's online flight on
@@ -154,6 +163,9 @@ struct OnlineConfig {
     a("look_ahead_best_view", look_ahead_best_view);
     a("stop_before_unknown", stop_before_unknown);
     a("renew_views", renew_views);
+    a("guard_tracking", guard_tracking);
+    a("guard_inliers", guard_inliers);
+    a("guard_range_m", guard_range_m);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("max_flight_s", max_flight_s);

@@ -236,11 +236,14 @@ double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception) {
   return std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
 }
 
-control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s) {
+control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s, double rate_hz) {
   control::TrajectorySetpoint sp;
   sp.p_WB = pose.p_WB;
   sp.yaw_rad = pose.yaw_rad;
-  return control::SetpointTrajectory({0.0, duration_s}, {sp, sp});
+  const int n = std::max(1, static_cast<int>(std::ceil(duration_s * rate_hz - 1e-9)));
+  std::vector<double> t;
+  for (int i = 0; i <= n; ++i) t.push_back(duration_s * i / n);
+  return control::SetpointTrajectory(t, std::vector<control::TrajectorySetpoint>(t.size(), sp));
 }
 
 }  // namespace tgnav::harness

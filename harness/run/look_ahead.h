@@ -106,8 +106,12 @@ std::vector<planner::Pose4> stopBeforeUnknown(const std::vector<planner::Pose4>&
 // The look-ahead keeps the way ahead within the horizontal field of view, 10 deg inside its edge.
 double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception);
 
-// A trajectory that holds `pose` for `duration_s` (a vehicle without a route waits for one).
-control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s);
+// A trajectory that holds `pose` for `duration_s` (a vehicle without a route waits for one), with
+// a setpoint every 1 / rate_hz: a splice (control::spliceTrajectory) blends at the new trajectory's
+// setpoints, and a hold of two setpoints left the current trajectory's velocity and yaw rate as
+// feed-forward, fading over the whole hold (the vehicle flew on 0.4 m past the hold and turned 19 deg
+// past its yaw).
+control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s, double rate_hz);
 
 // `trajectory` with its yaw from time `from_s` on held within `max_rate` of the yaw before it (a
 // forward pass: a faster turn is spread out and followed late, then joins the trajectory's own yaw

@@ -12,6 +12,7 @@
 #include "harness/run/look_ahead.h"
 #include "harness/run/online_metrics.h"
 #include "harness/run/unseen_prior.h"
+#include "harness/run/view_guard.h"
 
 namespace tgnav::harness {
 
@@ -31,34 +32,6 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   MapBuildConfig config;
   config.resolution_m = survey.resolution();
   return config;
-}
-
-// Marks free the never-observed voxels of `tree` within `radius_m` (horizontally) of each of
-// `centres`, over the band: where the vehicle has been, and the goal the mission gives, are free
-// whether the camera saw them or not. With unknown_space: blocked the planners see only these and
-// what was observed free; without them the start's own voxels, which the forward camera never
-// sees, left no route from no map (`invalid_start`, then `no_path`).
-void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres, double radius_m,
-              const ClearanceBand& band) {
-  const double res = tree->getResolution();
-  const int n = static_cast<int>(std::ceil(radius_m / res)) + 1;
-  for (const Eigen::Vector3d& c : centres) {
-    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
-      const octomap::OcTreeKey key =
-          tree->coordToKey(static_cast<double>(c.x()), static_cast<double>(c.y()), static_cast<double>(z));
-      for (int i = -n; i <= n; ++i) {
-        for (int j = -n; j <= n; ++j) {
-          octomap::OcTreeKey k = key;
-          k[0] = static_cast<octomap::key_type>(k[0] + i);
-          k[1] = static_cast<octomap::key_type>(k[1] + j);
-          const octomap::point3d v = tree->keyToCoord(k);
-          if (std::hypot(v.x() - c.x(), v.y() - c.y()) > radius_m) continue;
-          if (tree->search(k) == nullptr) tree->updateNode(k, false, /*lazy_eval=*/true);
-        }
-      }
-    }
-  }
-  tree->updateInnerOccupancy();
 }
 
 // How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
@@ -88,6 +61,11 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
   if (scenario.planner.oracle_class >= 0) {
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +
                      ": an online trial plans again on the map it builds, whose classes change; use trial.mode prior");
+  }
+  if (cfg_.guard_tracking && !external) {
+    constexpr double kGuardMinTurnRad = 5.0 * M_PI / 180.0;
+    guard_.emplace(cfg_.guard_inliers, kGuardMinTurnRad, 0.5 * scenario.planner.perception.visibility.hfov_rad,
+                   cfg_.guard_range_m);
   }
   const planner::Pose4& start = scenario.scene.start;
   switch (cfg_.prior_map) {
@@ -138,6 +116,11 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
     free.push_back(scenario_.scene.goal.p_WB);
     markFree(&built.map.occupancy(), free, clear_m, clearanceBand(scenario_));
   }
+  if (!wedges_.empty()) {
+    std::vector<Eigen::Vector3d> keep = visited_;
+    keep.push_back(scenario_.scene.goal.p_WB);
+    blockWedges(&built.map.occupancy(), wedges_, clearanceBand(scenario_), keep, clear_m);
+  }
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   if (cfg_.unseen_prior == UnseenPrior::kMean && !external_ && planner_ != planner::PlannerKind::kAgnostic) {
     const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
@@ -180,7 +163,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
       a.run.plan.path = std::move(part);
       a.stops_short = true;
       if (a.run.plan.path.size() < 2) {  // nowhere to go yet: turn where it is to see the way on
-        a.raw = holdTrajectory(a.run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s);
+        a.raw = holdTrajectory(a.run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s, rate_hz);
       } else {
         smoothPath(from_here, a.run.plan.path, nullptr, &a.run);
         a.record.trajectory_s += a.run.trajectory_s;
@@ -272,7 +255,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
     // No route yet: climb to the flight height and look.
     start.p_WB.z() = scenario_.scene.flight_height_m;
     current_ = std::make_unique<control::SetpointTrajectory>(
-        holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s));
+        holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()));
     failed_in_a_row_ = 1;
     holding_ = true;
   }
@@ -386,11 +369,36 @@ void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double traject
   result_.map_update_s += secondsSince(t0);
 }
 
+void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const Eigen::Isometry3d& X_WC, int inliers) {
+  if (!guard_ || t_s < trajectory_start_s) return;
+  const Eigen::Vector3d axis = X_WC.linear().col(2);  // the optical axis
+  const double yaw = std::atan2(axis.y(), axis.x());
+  const double good = guard_->goodYaw();
+  const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers);
+  if (!wedge) return;
+  wedges_.push_back(*wedge);
+  result_.guards.push_back(GuardEvent{t_s, X_WC.translation(), yaw, good, inliers, *wedge});
+  const double tau_now = tau(t_s, trajectory_start_s);
+  const planner::Pose4 hold{current_->sample(tau_now).p_WB, good};
+  // A reflex, not a plan: it stops within kGuardBlendS (a deceleration of about 1.3 m/s^2 at 0.4 m/s).
+  constexpr double kGuardBlendS = 0.3;
+  switchTo(holdTrajectory(hold, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_now, kGuardBlendS);
+  holding_ = true;
+  stops_short_ = false;
+  blind_view_ = true;
+  pending_until_s_ = t_s;
+}
+
+std::string OnlinePlanning::takeTrigger() {
+  const char* why = blind_view_ ? "blind_view" : blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period";
+  blind_view_ = blocked_ = goal_event_ = false;
+  return why;
+}
+
 std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   if (!planner_failure_.empty()) return planner_failure_;
-  if (t_s < pending_until_s_ - 1e-9 || (t_s < next_replan_s_ - 1e-9 && !blocked_ && !goal_event_)) {
-    return std::string();
-  }
+  const bool event = blocked_ || goal_event_ || blind_view_;
+  if (t_s < pending_until_s_ - 1e-9 || (t_s < next_replan_s_ - 1e-9 && !event)) return std::string();
   const planner::Pose4& goal = scenario_.scene.goal;
   const double t_eff = t_s + cfg_.plan_latency_s;
   const bool before_start = t_eff <= trajectory_start_s;
@@ -405,13 +413,11 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   const bool arriving = (start.p_WB - goal.p_WB).head<2>().norm() <= 0.5 * scenario_.trial.goal_radius_m;
   if (arriving && failed_in_a_row_ == 0) {
     next_replan_s_ = std::numeric_limits<double>::infinity();  // the current trajectory ends at the goal
-    blocked_ = false;
+    takeTrigger();
     return std::string();
   }
-  Attempt a = planClearOf(start, t_s, blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period");
+  Attempt a = planClearOf(start, t_s, takeTrigger());
   next_replan_s_ = t_s + cfg_.replan_period_s;
-  blocked_ = false;
-  goal_event_ = false;
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
   // to this one.
   const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
@@ -445,6 +451,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     pending_until_s_ = t_eff;
     failed_in_a_row_ = 0;
     holding_ = false;
+    if (guard_) guard_->rearm();
     result_.plans.push_back(std::move(a.record));
     return std::string();
   }
@@ -459,7 +466,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   }
   if (spent || blockedAhead(tau_now)) {
     // Stop where the current trajectory is at the switch, and wait for a route.
-    switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s), tau_switch,
+    switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_switch,
              before_start ? 0.0 : cfg_.blend_s);
     holding_ = true;
     pending_until_s_ = t_eff;

@@ -16,6 +16,7 @@
 // a surface not yet seen has no landmarks, so the proposed planner rates views of it blind (the
 // prior: an unseen surface gives the VO nothing) and prefers routes past what it has seen textured.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,6 +27,7 @@
 #include "harness/run/external_plan.h"
 #include "harness/run/incremental_map.h"
 #include "harness/run/plan_run.h"
+#include "harness/run/view_guard.h"
 #include "planner/feature_map.h"
 
 namespace tgnav::harness {
@@ -85,6 +87,7 @@ struct OnlineResult {
   double map_error_far_share = 0.0;           // ... share farther than two voxels from it
   double unknown_share = 0.0;                 // of the flown trajectory: in space unknown when planned
   std::optional<std::string> planner_stderr;  // an external planner's: the last lines it wrote to stderr
+  std::vector<GuardEvent> guards;             // trial.guard_tracking: when the guard tripped
 };
 
 // Whether a plan's choice is blind for less than its candidate along the current route by more
@@ -126,6 +129,11 @@ class OnlinePlanning {
   // Maps one keyframe at frame.X_WC, and notes whether the path ahead now runs into occupied space.
   void mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s);
 
+  // The VO's result for a frame it tracked (flying on the estimate): its pose and inliers, for the
+  // tracking guard (trial.guard_tracking; view_guard.h). When it trips, the vehicle holds where its
+  // trajectory is now, the camera turned back, and a plan is due ("blind_view").
+  void trackFrame(double t_s, double trajectory_start_s, const Eigen::Isometry3d& X_WC, int inliers);
+
   // At simulated time t: replans when one is due. Returns why the flight must stop (no route and
   // the current one blocked or spent), or an empty string.
   std::string replan(double t_s, double trajectory_start_s);
@@ -141,6 +149,8 @@ class OnlinePlanning {
  private:
   struct Attempt;
   Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
+  // Why a plan is asked now ("blind_view", "blocked", "goal_seen" or "period"); clears the events.
+  std::string takeTrigger();
   // plan(), and where a built-in planner finds `start` within the robot radius of the map
   // (`invalid_start`), plan() again from the nearest point that clears it (record.start_shift_m).
   Attempt planClearOf(const planner::Pose4& start, double t_s, const std::string& trigger);
@@ -153,6 +163,7 @@ class OnlinePlanning {
   // a.record's chosen_blind_m and route_blind_m, the route being `ahead` (positionsAhead).
   static void rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a);
   // Blind lengths this close count as equal (planner.selection.blind_tolerance_m).
+  double holdRate() const { return scenario_.planner.trajectory.sample_rate_hz; }
   double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }
   void renewViews(const Attempt& a, double tau_switch);
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
@@ -179,7 +190,10 @@ class OnlinePlanning {
   bool blocked_ = false;
   bool goal_seen_ = false;                // the goal's voxel has been observed
   bool goal_event_ = false;               // ... by the last keyframe: a plan is due
-  bool holding_ = false;                  // flying a hold: no route
+  bool holding_ = false;                  // flying a hold: no route, or the guard tripped
+  std::optional<ViewGuard> guard_;        // trial.guard_tracking, built-in planners
+  std::vector<BlindWedge> wedges_;        // ... where it tripped: unknown space there is planned occupied
+  bool blind_view_ = false;               // ... it tripped: a plan is due
   bool stops_short_ = false;              // the trajectory flown stops short of unknown space
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not

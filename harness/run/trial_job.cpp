@@ -223,7 +223,18 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["path"] = path;  // x, y, z, unknown when planned (0/1)
     plans.push_back(j);
   }
-  return {{"plans", plans}};
+  nlohmann::ordered_json guards = nlohmann::ordered_json::array();
+  for (const GuardEvent& g : online.guards) {
+    guards.push_back({{"t_s", g.t_s},
+                      {"p", {g.p.x(), g.p.y(), g.p.z()}},
+                      {"yaw_rad", g.yaw_rad},
+                      {"good_yaw_rad", g.good_yaw_rad},
+                      {"inliers", g.inliers},
+                      {"wedge_from_rad", g.wedge.from_rad},
+                      {"wedge_width_rad", g.wedge.width_rad},
+                      {"wedge_range_m", g.wedge.range_m}});
+  }
+  return {{"plans", plans}, {"guards", guards}};
 }
 
 void writeData(const fs::path& d, const Scenario& scenario, const TrialOptions& options, const TrialResult& r) {

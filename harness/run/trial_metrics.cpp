@@ -120,6 +120,7 @@ nlohmann::ordered_json onlineJson(const Scenario& scenario, const TrialResult& r
   j["replans"] = o.plans.empty() ? 0 : static_cast<int>(o.plans.size()) - 1;
   j["plans_flown"] = adopted;  // the first, and those that changed the route
   j["plans_renewing_views"] = renewed;
+  j["guard_trips"] = o.guards.size();  // trial.guard_tracking
   j["replan_times_s"] = times;
   const std::optional<double> reached = timeToGoal(scenario, result);
   j["time_to_goal_s"] = reached ? ordered_json(*reached) : ordered_json(nullptr);

@@ -397,6 +397,12 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.prior_radius_m = 0.0;
   EXPECT_EQ(invalidArgument(t), "prior_radius_m = 0: must be > 0");
   t = TrialConfig{};
+  t.online.guard_inliers = 0;
+  EXPECT_EQ(invalidArgument(t), "guard_inliers = 0: must be in [1, 10000]");
+  t = TrialConfig{};
+  t.online.guard_range_m = 0.0;
+  EXPECT_EQ(invalidArgument(t), "guard_range_m = 0: must be in (0, 100]");
+  t = TrialConfig{};
   t.online.look_ahead_best_view = true;
   EXPECT_EQ(invalidArgument(t), "");
   t.online.look_ahead_keeps_tracking = true;

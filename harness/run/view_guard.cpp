@@ -1,0 +1,103 @@
+#include "harness/run/view_guard.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tgnav::harness {
+
+namespace {
+
+double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+}  // namespace
+
+bool inWedge(const BlindWedge& wedge, const Eigen::Vector3d& p) {
+  const Eigen::Vector2d d = (p - wedge.apex).head<2>();
+  const double r = d.norm();
+  if (r > wedge.range_m) return false;
+  if (r < 1e-9) return false;  // the apex itself: where the vehicle was
+  double off = std::atan2(d.y(), d.x()) - wedge.from_rad;
+  off = off - 2.0 * M_PI * std::floor(off / (2.0 * M_PI));  // in [0, 2 pi)
+  return off <= wedge.width_rad;
+}
+
+std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers) {
+  recent_.emplace_back(t_s, yaw_rad);
+  while (recent_.size() > 1 && recent_[1].first <= t_s - kTurnWindowS + 1e-9) recent_.pop_front();
+  if (inliers >= min_inliers_) {
+    has_good_ = true;
+    good_yaw_rad_ = yaw_rad;
+    if (rearm_) armed_ = true;
+    rearm_ = false;
+    return std::nullopt;
+  }
+  const double turning = wrapAngle(yaw_rad - recent_.front().second);
+  if (!armed_ || !has_good_ || std::abs(turning) < min_turn_rad_) return std::nullopt;
+  armed_ = false;
+  // The new part of the view: from the good view's edge on the side turned to, to the bad view's
+  // far edge and kBeyondRad on.
+  const double turned = std::abs(wrapAngle(yaw_rad - good_yaw_rad_));
+  const double width = std::min(M_PI, turned + kBeyondRad);
+  BlindWedge w;
+  w.apex = p;
+  w.range_m = range_m_;
+  w.width_rad = width;
+  w.from_rad =
+      turning > 0.0 ? wrapAngle(good_yaw_rad_ + half_fov_rad_) : wrapAngle(good_yaw_rad_ - half_fov_rad_ - width);
+  return w;
+}
+
+int blockWedges(octomap::OcTree* tree, const std::vector<BlindWedge>& wedges, const ClearanceBand& band,
+                const std::vector<Eigen::Vector3d>& keep_free, double keep_m) {
+  const double res = tree->getResolution();
+  int marked = 0;
+  for (const BlindWedge& w : wedges) {
+    const int n = static_cast<int>(std::ceil(w.range_m / res)) + 1;
+    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
+      const octomap::OcTreeKey key = tree->coordToKey(w.apex.x(), w.apex.y(), z);
+      for (int i = -n; i <= n; ++i) {
+        for (int j = -n; j <= n; ++j) {
+          octomap::OcTreeKey k = key;
+          k[0] = static_cast<octomap::key_type>(k[0] + i);
+          k[1] = static_cast<octomap::key_type>(k[1] + j);
+          const octomap::point3d c = tree->keyToCoord(k);
+          const Eigen::Vector3d v(c.x(), c.y(), c.z());
+          if (!inWedge(w, v) || (v - w.apex).head<2>().norm() <= keep_m) continue;
+          if (tree->search(k) != nullptr) continue;  // observed: planned as it is
+          const bool kept = std::any_of(keep_free.begin(), keep_free.end(),
+                                        [&](const Eigen::Vector3d& f) { return (v - f).head<2>().norm() <= keep_m; });
+          if (kept) continue;
+          tree->updateNode(k, true, /*lazy_eval=*/true);
+          ++marked;
+        }
+      }
+    }
+  }
+  if (marked > 0) tree->updateInnerOccupancy();
+  return marked;
+}
+
+void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres, double radius_m,
+              const ClearanceBand& band) {
+  const double res = tree->getResolution();
+  const int n = static_cast<int>(std::ceil(radius_m / res)) + 1;
+  for (const Eigen::Vector3d& c : centres) {
+    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
+      const octomap::OcTreeKey key =
+          tree->coordToKey(static_cast<double>(c.x()), static_cast<double>(c.y()), static_cast<double>(z));
+      for (int i = -n; i <= n; ++i) {
+        for (int j = -n; j <= n; ++j) {
+          octomap::OcTreeKey k = key;
+          k[0] = static_cast<octomap::key_type>(k[0] + i);
+          k[1] = static_cast<octomap::key_type>(k[1] + j);
+          const octomap::point3d v = tree->keyToCoord(k);
+          if (std::hypot(v.x() - c.x(), v.y() - c.y()) > radius_m) continue;
+          if (tree->search(k) == nullptr) tree->updateNode(k, false, /*lazy_eval=*/true);
+        }
+      }
+    }
+  }
+  tree->updateInnerOccupancy();
+}
+
+}  // namespace tgnav::harness

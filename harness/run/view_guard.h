@@ -1,0 +1,92 @@
+#pragma once
+// The tracking guard of an online trial (trial.guard_tracking): the VO's own inlier count, not a
+// prediction, stops a turn of the camera that is losing the texture it tracks.
+//
+// Online, a surface is rated only once seen, so the first look into unknown space whose walls are
+// bare is blind, and the VO was lost there on every planner (docs/results/online10). A real VO knows
+// how many points it still tracks. When a frame tracks fewer than `min_inliers` while the camera
+// turns (by at least `min_turn_rad` over the last kTurnWindowS), the guard trips: the vehicle stops where it is, turns
+// back to the good yaw, and the space it was turning toward (the new part of the view, from the good view's edge to the
+// bad view's far edge and kBeyondRad on) becomes a blind wedge. Unknown space inside a wedge, within its range of the
+// place it was seen from, is planned as occupied: the vehicle does not fly into space it cannot
+// look at while the VO tracks. Observed space inside it is planned as it is.
+#include <octomap/OcTree.h>
+
+#include <Eigen/Core>
+#include <deque>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "harness/run/plan_run.h"
+
+namespace tgnav::harness {
+
+// Horizontal bearings from `from_rad` counter-clockwise over `width_rad` (at most pi), seen from
+// `apex`, out to `range_m`.
+struct BlindWedge {
+  Eigen::Vector3d apex = Eigen::Vector3d::Zero();
+  double from_rad = 0.0;
+  double width_rad = 0.0;
+  double range_m = 0.0;
+};
+
+// Whether `p` lies inside the wedge (horizontally; its height is not compared).
+bool inWedge(const BlindWedge& wedge, const Eigen::Vector3d& p);
+
+// When the guard tripped, for online.json.
+struct GuardEvent {
+  double t_s = 0.0;
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  // the camera, estimated
+  double yaw_rad = 0.0;                         // its yaw at the frame that tripped it
+  double good_yaw_rad = 0.0;                    // the last yaw that tracked enough
+  int inliers = 0;
+  BlindWedge wedge;
+};
+
+class ViewGuard {
+ public:
+  // How far past the bad view's far edge the wedge reaches: the turn was heading that way.
+  static constexpr double kBeyondRad = M_PI / 4.0;
+  // The camera turns when its yaw changed by min_turn_rad over this long.
+  static constexpr double kTurnWindowS = 0.5;
+
+  // half_fov_rad: half the camera's horizontal field of view.
+  ViewGuard(int min_inliers, double min_turn_rad, double half_fov_rad, double range_m)
+      : min_inliers_(min_inliers), min_turn_rad_(min_turn_rad), half_fov_rad_(half_fov_rad), range_m_(range_m) {}
+
+  // One tracked frame: the camera's position and yaw (estimated) and the VO's inliers. Returns the
+  // blind wedge when the guard trips; it then stays disarmed until rearm().
+  std::optional<BlindWedge> observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers);
+  // Arms it again from the next frame that tracks enough (a new plan is flown).
+  void rearm() { rearm_ = true; }
+  bool armed() const { return armed_; }
+  double goodYaw() const { return good_yaw_rad_; }
+
+ private:
+  int min_inliers_;
+  double min_turn_rad_;
+  double half_fov_rad_;
+  double range_m_;
+  bool armed_ = true;
+  bool rearm_ = false;
+  bool has_good_ = false;
+  double good_yaw_rad_ = 0.0;
+  std::deque<std::pair<double, double>> recent_;  // (time, yaw) over the last kTurnWindowS
+};
+
+// Marks occupied every voxel of `tree` never observed, over the band, inside any of `wedges`,
+// except within keep_m (horizontally) of the wedge's apex or of any of `keep_free` (where the
+// vehicle has been, the goal). Returns how many it marked.
+int blockWedges(octomap::OcTree* tree, const std::vector<BlindWedge>& wedges, const ClearanceBand& band,
+                const std::vector<Eigen::Vector3d>& keep_free, double keep_m);
+
+// Marks free the never-observed voxels of `tree` within `radius_m` (horizontally) of each of
+// `centres`, over the band: where the vehicle has been, and the goal the mission gives, are free
+// whether the camera saw them or not. With unknown_space: blocked the planners see only these and
+// what was observed free; without them the start's own voxels, which the forward camera never
+// sees, left no route from no map (`invalid_start`, then `no_path`).
+void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres, double radius_m,
+              const ClearanceBand& band);
+
+}  // namespace tgnav::harness

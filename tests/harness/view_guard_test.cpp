@@ -1,0 +1,135 @@
+// The tracking guard of an online trial (harness/run/view_guard.h): when it trips, which wedge of
+// bearings it blames, and how that wedge's unknown space is planned.
+#include "harness/run/view_guard.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "control/trajectory.h"
+#include "harness/run/look_ahead.h"
+
+namespace tgnav::harness {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kHalfFov = 37.5 * kDeg;
+
+ViewGuard guard() { return ViewGuard(150, 5.0 * kDeg, kHalfFov, 3.0); }
+
+TEST(ViewGuard, TripsOnlyWhenATurningCameraLosesTheInliers) {
+  ViewGuard g = guard();
+  const Eigen::Vector3d p(1.0, 2.0, 1.0);
+  // Nothing tracked well yet: nothing to turn back to.
+  EXPECT_FALSE(g.observe(0.0, p, 0.0, 40).has_value());
+  EXPECT_FALSE(g.observe(0.05, p, 0.0, 400).has_value());
+  // Few inliers while still (3 deg over the last 0.5 s): not the turn's doing.
+  EXPECT_FALSE(g.observe(0.10, p, 1.0 * kDeg, 100).has_value());
+  EXPECT_FALSE(g.observe(0.40, p, 3.0 * kDeg, 100).has_value());
+  // A turn of 5 deg or more over the last 0.5 s, losing them: trips.
+  const auto w = g.observe(0.45, p, 6.0 * kDeg, 100);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_DOUBLE_EQ(g.goodYaw(), 0.0);
+  // The new part of the view: from the good view's left edge over the 6 deg turned and 45 deg on.
+  EXPECT_NEAR(w->from_rad, kHalfFov, 1e-12);
+  EXPECT_NEAR(w->width_rad, 6.0 * kDeg + ViewGuard::kBeyondRad, 1e-12);
+  EXPECT_EQ(w->apex, p);
+  EXPECT_DOUBLE_EQ(w->range_m, 3.0);
+  // Disarmed until a new plan is flown and a frame tracks enough again.
+  EXPECT_FALSE(g.observe(0.50, p, 20.0 * kDeg, 50).has_value());
+  g.rearm();
+  EXPECT_FALSE(g.observe(0.55, p, 30.0 * kDeg, 50).has_value());
+  EXPECT_FALSE(g.observe(0.60, p, 90.0 * kDeg, 200).has_value());  // tracks enough: armed, new good yaw
+  EXPECT_TRUE(g.observe(0.65, p, 70.0 * kDeg, 149).has_value());   // turning right
+}
+
+TEST(ViewGuard, ATurnToTheRightBlamesTheBearingsRightOfTheGoodView) {
+  ViewGuard g = guard();
+  const Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  g.observe(0.0, p, M_PI - 0.1, 500);                 // across the +-pi seam
+  const auto w = g.observe(0.1, p, -M_PI + 0.2, 10);  // 0.3 rad to the left, through the seam
+  ASSERT_TRUE(w.has_value());
+  // Left of a view looking at ~pi: bearings beyond pi - 0.1 + half fov.
+  const double left = M_PI - 0.1 + kHalfFov + 0.1;
+  EXPECT_TRUE(inWedge(*w, Eigen::Vector3d(std::cos(left), std::sin(left), 0.0)));
+  ViewGuard h = guard();
+  h.observe(0.0, p, 0.0, 500);
+  const auto r = h.observe(0.1, p, -0.5, 10);
+  ASSERT_TRUE(r.has_value());
+  const double right_edge = -kHalfFov;
+  auto at = [](double bearing, double range) {
+    return Eigen::Vector3d(range * std::cos(bearing), range * std::sin(bearing), 1.0);
+  };
+  EXPECT_TRUE(inWedge(*r, at(right_edge - 0.05, 2.0)));
+  EXPECT_TRUE(inWedge(*r, at(right_edge - 0.5 - ViewGuard::kBeyondRad + 0.05, 2.0)));
+  EXPECT_FALSE(inWedge(*r, at(right_edge - 0.5 - ViewGuard::kBeyondRad - 0.05, 2.0)));  // past it
+  EXPECT_FALSE(inWedge(*r, at(right_edge + 0.05, 2.0)));                                // inside the good view
+  EXPECT_FALSE(inWedge(*r, at(0.0, 1.0)));               // straight ahead of the good view
+  EXPECT_FALSE(inWedge(*r, at(right_edge - 0.1, 3.5)));  // beyond its range
+}
+
+TEST(BlockWedges, MarksOnlyUnknownSpaceInsideTheWedgeAwayFromKeptPlaces) {
+  octomap::OcTree tree(0.1);
+  // Observed free: a 1 m square right of the apex, ahead of the vehicle (x in [1, 2]).
+  for (double x = 1.05; x < 2.0; x += 0.1) {
+    for (double y = -0.95; y < 0.0; y += 0.1) {
+      for (double z = 0.75; z < 1.3; z += 0.1) tree.updateNode(octomap::point3d(x, y, z), false);
+    }
+  }
+  BlindWedge w;
+  w.apex = Eigen::Vector3d(0.0, 0.0, 1.0);
+  w.from_rad = -M_PI / 2.0;  // bearings -90 .. 0 deg: the quadrant x > 0, y < 0
+  w.width_rad = M_PI / 2.0;
+  w.range_m = 2.5;
+  const ClearanceBand band{0.7, 1.3};
+  const Eigen::Vector3d kept(0.5, -1.5, 1.0);
+  const int marked = blockWedges(&tree, {w}, band, {kept}, 0.4);
+  EXPECT_GT(marked, 0);
+  auto occupied = [&](double x, double y) {
+    const octomap::OcTreeNode* n = tree.search(x, y, 1.05);
+    return n != nullptr && tree.isNodeOccupied(n);
+  };
+  auto unknown = [&](double x, double y) { return tree.search(x, y, 1.05) == nullptr; };
+  EXPECT_TRUE(occupied(0.85, -1.15));  // unknown, inside: blocked
+  EXPECT_TRUE(occupied(2.05, -0.35));
+  EXPECT_FALSE(occupied(1.45, -0.45));  // observed free: as it is
+  EXPECT_TRUE(unknown(-0.55, -1.05));   // outside the wedge's bearings
+  EXPECT_TRUE(unknown(1.05, 0.55));
+  EXPECT_TRUE(unknown(2.35, -1.35));                   // beyond its range (2.73 m)
+  EXPECT_TRUE(unknown(0.15, -0.15));                   // within keep_m of the apex
+  EXPECT_TRUE(unknown(0.55, -1.45));                   // within keep_m of a kept place
+  EXPECT_EQ(tree.search(0.85, -1.15, 1.55), nullptr);  // above the band
+}
+
+// The guard's stop (and a vehicle's hold without a route): a hold spliced into a moving, turning
+// trajectory is at rest, at its place and yaw, from the end of the blend on.
+TEST(HoldTrajectory, SplicedIntoAMovingTrajectoryItIsAtRestOnceTheBlendEnds) {
+  std::vector<double> t;
+  std::vector<control::TrajectorySetpoint> sp;
+  for (int i = 0; i <= 1000; ++i) {
+    control::TrajectorySetpoint s;
+    s.p_WB = Eigen::Vector3d(0.4 * i * 0.01, 0.0, 1.0);
+    s.v_WB = Eigen::Vector3d(0.4, 0.0, 0.0);
+    s.yaw_rad = -0.6 * i * 0.01;
+    s.yaw_rate_rad_s = -0.6;
+    t.push_back(i * 0.01);
+    sp.push_back(s);
+  }
+  const control::SetpointTrajectory moving(t, sp);
+  const planner::Pose4 hold{Eigen::Vector3d(0.8, 0.0, 1.0), -1.0};
+  const control::SetpointTrajectory h = holdTrajectory(hold, 4.5, 100.0);
+  EXPECT_EQ(h.times().size(), 451U);
+  const control::SetpointTrajectory spliced = control::spliceTrajectory(moving, h, 2.0, 0.3);
+  EXPECT_NEAR(spliced.sample(1.99).v_WB.x(), 0.4, 1e-9);  // before the switch: as it was
+  for (double tt = 2.3; tt <= 6.5; tt += 0.05) {
+    const control::TrajectorySetpoint s = spliced.sample(tt);
+    EXPECT_NEAR((s.p_WB - hold.p_WB).norm(), 0.0, 1e-9) << tt;
+    EXPECT_NEAR(s.v_WB.norm(), 0.0, 1e-9) << tt;
+    EXPECT_NEAR(s.yaw_rad, -1.0, 1e-9) << tt;
+    EXPECT_NEAR(s.yaw_rate_rad_s, 0.0, 1e-9) << tt;
+  }
+}
+
+}  // namespace
+}  // namespace tgnav::harness
