@@ -226,7 +226,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
   nlohmann::ordered_json guards = nlohmann::ordered_json::array();
   for (const GuardEvent& g : online.guards) {
     guards.push_back({{"t_s", g.t_s},
-                      {"p", {g.p.x(), g.p.y(), g.p.z()}},
+                      {"p", {g.wedge.apex.x(), g.wedge.apex.y(), g.wedge.apex.z()}},
                       {"yaw_rad", g.yaw_rad},
                       {"good_yaw_rad", g.good_yaw_rad},
                       {"inliers", g.inliers},

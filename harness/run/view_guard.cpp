@@ -9,6 +9,28 @@ namespace {
 
 double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
+// Calls fn(key, voxel centre) for every voxel of `tree`'s grid over the band whose centre lies
+// within radius_m of `centre` horizontally, layer by layer from the band's bottom.
+template <typename Fn>
+void forEachKeyWithin(const octomap::OcTree& tree, const Eigen::Vector3d& centre, double radius_m,
+                      const ClearanceBand& band, Fn fn) {
+  const double res = tree.getResolution();
+  const int n = static_cast<int>(std::ceil(radius_m / res)) + 1;
+  for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
+    const octomap::OcTreeKey key = tree.coordToKey(centre.x(), centre.y(), z);
+    for (int i = -n; i <= n; ++i) {
+      for (int j = -n; j <= n; ++j) {
+        octomap::OcTreeKey k = key;
+        k[0] = static_cast<octomap::key_type>(k[0] + i);
+        k[1] = static_cast<octomap::key_type>(k[1] + j);
+        const octomap::point3d c = tree.keyToCoord(k);
+        const Eigen::Vector3d v(c.x(), c.y(), c.z());
+        if ((v - centre).head<2>().norm() <= radius_m) fn(k, v);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool inWedge(const BlindWedge& wedge, const Eigen::Vector3d& p) {
@@ -49,29 +71,17 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
 
 int blockWedges(octomap::OcTree* tree, const std::vector<BlindWedge>& wedges, const ClearanceBand& band,
                 const std::vector<Eigen::Vector3d>& keep_free, double keep_m) {
-  const double res = tree->getResolution();
   int marked = 0;
   for (const BlindWedge& w : wedges) {
-    const int n = static_cast<int>(std::ceil(w.range_m / res)) + 1;
-    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
-      const octomap::OcTreeKey key = tree->coordToKey(w.apex.x(), w.apex.y(), z);
-      for (int i = -n; i <= n; ++i) {
-        for (int j = -n; j <= n; ++j) {
-          octomap::OcTreeKey k = key;
-          k[0] = static_cast<octomap::key_type>(k[0] + i);
-          k[1] = static_cast<octomap::key_type>(k[1] + j);
-          const octomap::point3d c = tree->keyToCoord(k);
-          const Eigen::Vector3d v(c.x(), c.y(), c.z());
-          if (!inWedge(w, v) || (v - w.apex).head<2>().norm() <= keep_m) continue;
-          if (tree->search(k) != nullptr) continue;  // observed: planned as it is
-          const bool kept = std::any_of(keep_free.begin(), keep_free.end(),
-                                        [&](const Eigen::Vector3d& f) { return (v - f).head<2>().norm() <= keep_m; });
-          if (kept) continue;
-          tree->updateNode(k, true, /*lazy_eval=*/true);
-          ++marked;
-        }
-      }
-    }
+    forEachKeyWithin(*tree, w.apex, w.range_m, band, [&](const octomap::OcTreeKey& k, const Eigen::Vector3d& v) {
+      if (!inWedge(w, v) || (v - w.apex).head<2>().norm() <= keep_m) return;
+      if (tree->search(k) != nullptr) return;  // observed: planned as it is
+      const bool kept = std::any_of(keep_free.begin(), keep_free.end(),
+                                    [&](const Eigen::Vector3d& f) { return (v - f).head<2>().norm() <= keep_m; });
+      if (kept) return;
+      tree->updateNode(k, true, /*lazy_eval=*/true);
+      ++marked;
+    });
   }
   if (marked > 0) tree->updateInnerOccupancy();
   return marked;
@@ -79,23 +89,10 @@ int blockWedges(octomap::OcTree* tree, const std::vector<BlindWedge>& wedges, co
 
 void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres, double radius_m,
               const ClearanceBand& band) {
-  const double res = tree->getResolution();
-  const int n = static_cast<int>(std::ceil(radius_m / res)) + 1;
   for (const Eigen::Vector3d& c : centres) {
-    for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
-      const octomap::OcTreeKey key =
-          tree->coordToKey(static_cast<double>(c.x()), static_cast<double>(c.y()), static_cast<double>(z));
-      for (int i = -n; i <= n; ++i) {
-        for (int j = -n; j <= n; ++j) {
-          octomap::OcTreeKey k = key;
-          k[0] = static_cast<octomap::key_type>(k[0] + i);
-          k[1] = static_cast<octomap::key_type>(k[1] + j);
-          const octomap::point3d v = tree->keyToCoord(k);
-          if (std::hypot(v.x() - c.x(), v.y() - c.y()) > radius_m) continue;
-          if (tree->search(k) == nullptr) tree->updateNode(k, false, /*lazy_eval=*/true);
-        }
-      }
-    }
+    forEachKeyWithin(*tree, c, radius_m, band, [&](const octomap::OcTreeKey& k, const Eigen::Vector3d&) {
+      if (tree->search(k) == nullptr) tree->updateNode(k, false, /*lazy_eval=*/true);
+    });
   }
   tree->updateInnerOccupancy();
 }

@@ -37,11 +37,10 @@ bool inWedge(const BlindWedge& wedge, const Eigen::Vector3d& p);
 // When the guard tripped, for online.json.
 struct GuardEvent {
   double t_s = 0.0;
-  Eigen::Vector3d p = Eigen::Vector3d::Zero();  // the camera, estimated
-  double yaw_rad = 0.0;                         // its yaw at the frame that tripped it
-  double good_yaw_rad = 0.0;                    // the last yaw that tracked enough
+  double yaw_rad = 0.0;       // the camera's (estimated) at the frame that tripped it
+  double good_yaw_rad = 0.0;  // the last yaw that tracked enough
   int inliers = 0;
-  BlindWedge wedge;
+  BlindWedge wedge;  // its apex: where the camera was (estimated)
 };
 
 class ViewGuard {
