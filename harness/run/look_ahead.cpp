@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 
 namespace tgnav::harness {
 
@@ -15,6 +16,9 @@ constexpr double kYawStepRad = 5.0 * M_PI / 180.0;  // between two rated yaws
 // The way half the look-ahead ahead stays this far beyond the way ahead's own limit (half_fov_rad,
 // 10 deg inside the image's edge): 5 deg inside the edge.
 constexpr double kNearMarginRad = 5.0 * M_PI / 180.0;
+// How far along the plan (in its time) the nearest point to a setpoint of the current trajectory is
+// looked for when a plan's yaw is carried over to it (renewedViews).
+constexpr double kRenewWindowS = 5.0;
 }  // namespace
 
 void ViewRater::moveTo(const Eigen::Vector3d& p_WB) {
@@ -202,6 +206,38 @@ std::vector<planner::Pose4> stopBeforeUnknown(const std::vector<planner::Pose4>&
     if (std::abs(off) > rule.half_fov_rad) yaw = heading - std::copysign(rule.half_fov_rad, off);
   }
   return out;
+}
+
+std::optional<control::SetpointTrajectory> renewedViews(const control::SetpointTrajectory& current,
+                                                        const control::SetpointTrajectory& plan, double tau_switch,
+                                                        double max_rate) {
+  const std::vector<double>& t = current.times();
+  const std::vector<control::TrajectorySetpoint>& from = plan.setpoints();
+  const double dt =
+      (plan.endTime() - plan.startTime()) / static_cast<double>(std::max<std::size_t>(1, from.size() - 1));
+  const auto window = static_cast<std::size_t>(std::lround(kRenewWindowS / std::max(dt, 1e-6)));
+  std::vector<double> tt;
+  std::vector<control::TrajectorySetpoint> sp;
+  std::size_t j = 0;  // the plan's point matched last: matches move forward along it
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < tau_switch - 1e-9) continue;
+    control::TrajectorySetpoint s = current.setpoints()[i];
+    double best = std::numeric_limits<double>::infinity();
+    const std::size_t j0 = j;
+    for (std::size_t k = j0; k < std::min(from.size(), j0 + window); ++k) {
+      const double d = (from[k].p_WB - s.p_WB).squaredNorm();
+      if (d < best) {
+        best = d;
+        j = k;
+      }
+    }
+    if (!sp.empty()) s.yaw_rad = from[j].yaw_rad;  // the first keeps the vehicle's
+    tt.push_back(t[i]);
+    sp.push_back(s);
+  }
+  if (tt.size() < 3) return std::nullopt;
+  smoothYaw(tt, max_rate, &sp);
+  return control::SetpointTrajectory(tt, std::move(sp));
 }
 
 control::SetpointTrajectory limitYawRate(const control::SetpointTrajectory& trajectory, double from_s,

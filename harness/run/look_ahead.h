@@ -3,6 +3,7 @@
 // that turns it toward unknown space before the vehicle flies there, within the trajectory's
 // yaw-rate limit.
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "control/trajectory.h"
@@ -112,6 +113,18 @@ double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception);
 // feed-forward, fading over the whole hold (the vehicle flew on 0.4 m past the hold and turned 19 deg
 // past its yaw).
 control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s, double rate_hz);
+
+// A renewal of the views (trial.renew_views): `current` from tau_switch on, each setpoint with the
+// yaw of the nearest point of `plan` (a plan along the same route, from where the vehicle will be at
+// tau_switch), looked for forward along it (within kRenewWindowS of plan time of the point matched
+// last); the first setpoint keeps its own yaw, the vehicle's, and the yaws are smoothed from it
+// (smoothYaw). Before, the first took the plan's yaw as well: every renewal (each replan_period_s)
+// pulled the camera back toward the planner's view and the look-ahead's turn toward the way ahead
+// never got there (storage seed 2: it looked away from a shelf it then flew into). Nothing (nullopt)
+// where fewer than 3 setpoints remain.
+std::optional<control::SetpointTrajectory> renewedViews(const control::SetpointTrajectory& current,
+                                                        const control::SetpointTrajectory& plan, double tau_switch,
+                                                        double max_rate);
 
 // `trajectory` with its yaw from time `from_s` on held within `max_rate` of the yaw before it (a
 // forward pass: a faster turn is spread out and followed late, then joins the trajectory's own yaw

@@ -34,10 +34,6 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
   return config;
 }
 
-// How far ahead (in `plan`'s samples) the nearest point to a setpoint of the current trajectory
-// is looked for when a plan's yaw is carried over to it (OnlinePlanning::renewViews).
-constexpr double kRenewWindowS = 5.0;
-
 }  // namespace
 
 struct OnlinePlanning::Attempt {
@@ -322,32 +318,9 @@ void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahea
 }
 
 void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
-  const std::vector<double>& t = current_->times();
-  const std::vector<control::TrajectorySetpoint>& from = a.raw->setpoints();
-  const auto window =
-      static_cast<std::size_t>(std::lround(kRenewWindowS * scenario_.planner.trajectory.sample_rate_hz));
-  std::vector<double> tt;
-  std::vector<control::TrajectorySetpoint> sp;
-  std::size_t j = 0;  // the plan's point matched last: matches move forward along it
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    if (t[i] < tau_switch - 1e-9) continue;
-    control::TrajectorySetpoint s = current_->setpoints()[i];
-    double best = std::numeric_limits<double>::infinity();
-    const std::size_t j0 = j;
-    for (std::size_t k = j0; k < std::min(from.size(), j0 + window); ++k) {
-      const double d = (from[k].p_WB - s.p_WB).squaredNorm();
-      if (d < best) {
-        best = d;
-        j = k;
-      }
-    }
-    s.yaw_rad = from[j].yaw_rad;
-    tt.push_back(t[i]);
-    sp.push_back(s);
-  }
-  if (tt.size() < 3) return;
-  smoothYaw(tt, scenario_.planner.trajectory.max_yaw_rate_rad_s, &sp);
-  switchTo(lookAhead(control::SetpointTrajectory(tt, std::move(sp)), *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  const std::optional<control::SetpointTrajectory> renewed =
+      renewedViews(*current_, *a.raw, tau_switch, scenario_.planner.trajectory.max_yaw_rate_rad_s);
+  if (renewed) switchTo(lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "harness/run/incremental_map.h"
@@ -76,6 +77,43 @@ TEST(LimitYawRate, HoldsTheLimitFromTheSwitchOnAndRejoinsTheYaw) {
   // Within the limit, nothing changes at all.
   const control::SetpointTrajectory slow = spinning(5.0, [](double t) { return 0.5 * t; });
   EXPECT_EQ(limitYawRate(slow, 0.0, 0.6).setpoints().back().yaw_rad, slow.setpoints().back().yaw_rad);
+}
+
+// Setpoints every 0.01 s over `duration_s` along the x axis at 0.4 m/s from the origin, yaw(t).
+template <typename Yaw>
+control::SetpointTrajectory along(double duration_s, double t0, const Yaw& yaw) {
+  std::vector<double> t;
+  std::vector<control::TrajectorySetpoint> sp;
+  for (int i = 0; i * 0.01 <= duration_s + 1e-9; ++i) {
+    t.push_back(t0 + i * 0.01);
+    control::TrajectorySetpoint s;
+    s.p_WB = Eigen::Vector3d(0.4 * i * 0.01, 0.0, 1.0);
+    s.v_WB = Eigen::Vector3d(0.4, 0.0, 0.0);
+    s.yaw_rad = yaw(i * 0.01);
+    sp.push_back(s);
+  }
+  return control::SetpointTrajectory(t, sp);
+}
+
+TEST(RenewedViews, KeepTheVehiclesYawAtTheSwitchAndTurnToThePlansWithinTheLimit) {
+  // Flying along x with the camera at yaw 0; a plan along the same line, made for the switch at
+  // t = 3 s (1.2 m along), looks at yaw 1.5 all the way.
+  const control::SetpointTrajectory current = along(10.0, 0.0, [](double) { return 0.0; });
+  const control::SetpointTrajectory plan = [&] {
+    control::SetpointTrajectory p = along(7.0, 0.0, [](double) { return 1.5; });
+    std::vector<control::TrajectorySetpoint> sp = p.setpoints();
+    for (control::TrajectorySetpoint& s : sp) s.p_WB.x() += 1.2;
+    return control::SetpointTrajectory(p.times(), sp);
+  }();
+  const std::optional<control::SetpointTrajectory> out = renewedViews(current, plan, 3.0, 0.6);
+  ASSERT_TRUE(out.has_value());
+  EXPECT_DOUBLE_EQ(out->startTime(), 3.0);
+  EXPECT_DOUBLE_EQ(out->sample(3.0).yaw_rad, 0.0);  // the vehicle's, not the plan's 1.5
+  EXPECT_LE(maxRate(*out), 0.6 + 1e-9);
+  EXPECT_NEAR(out->sample(8.0).yaw_rad, 1.5, 1e-6);                           // turned to the plan's view
+  EXPECT_DOUBLE_EQ(out->sample(6.0).p_WB.x(), current.sample(6.0).p_WB.x());  // the route as it was
+  // Too little left of the current trajectory: nothing.
+  EXPECT_FALSE(renewedViews(current, plan, 9.995, 0.6).has_value());
 }
 
 // A textured wall facing west at x = 3.5 (y in [-1.5, 1], z in [0.5, 1.5]), two landmarks on each
