@@ -403,12 +403,13 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   // (A plan exactly commit_s after the last change is not committed, whatever the rounding.)
   const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
   // Whether the plan follows the current route: asked only where it decides something.
-  const bool same =
-      in_flight && !must_switch && (!committed || cfg_.renew_views) && followsRoute(a.run.plan.path, ahead);
+  // Renewing the views is the built-in planners' (as the look-ahead): an external planner's yaw is its own.
+  const bool renew = cfg_.renew_views && !external_;
+  const bool same = in_flight && !must_switch && (!committed || renew) && followsRoute(a.run.plan.path, ahead);
   const bool keep = cfg_.keep_route && in_flight && !worthLeavingRoute(a.record, blindTolerance(), cfg_.route_margin);
   if (a.trajectory && !must_switch && (committed || same || keep)) {
     failed_in_a_row_ = 0;
-    if (cfg_.renew_views && same) {
+    if (renew && same) {
       renewViews(a, tau_switch);
       a.record.views_renewed = true;
       pending_until_s_ = t_eff;
