@@ -126,9 +126,9 @@ struct OnlineConfig {
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
   // (harness/run/look_ahead.h, renewedViews). false: the views of the plan last flown, planned
-  // where the way ahead was still unknown. On by default since 7ca8608: from no map the proposed
+  // where the way ahead was still unknown. On by default since 7b9d05e: from no map the proposed
   // planner kept the VO to the goal on storage in 9/10 against 1/10 (seeds 1-10) and 6/10 against
-  // 3/10 (seeds 21-30, flown after that commit; docs/results/renew).
+  // 3/10 (seeds 21-30, flown only after the fix of 7ca8608 was frozen; docs/results/renew).
   bool renew_views = true;
   // The tracking guard (harness/run/view_guard.h; the built-in planners, flying on the estimate):
   // a frame the VO tracks with fewer than guard_inliers inliers, 10 deg or more from the last

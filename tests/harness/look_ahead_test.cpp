@@ -81,11 +81,11 @@ TEST(LimitYawRate, HoldsTheLimitFromTheSwitchOnAndRejoinsTheYaw) {
 
 // Setpoints every 0.01 s over `duration_s` along the x axis at 0.4 m/s from the origin, yaw(t).
 template <typename Yaw>
-control::SetpointTrajectory along(double duration_s, double t0, const Yaw& yaw) {
+control::SetpointTrajectory along(double duration_s, const Yaw& yaw) {
   std::vector<double> t;
   std::vector<control::TrajectorySetpoint> sp;
   for (int i = 0; i * 0.01 <= duration_s + 1e-9; ++i) {
-    t.push_back(t0 + i * 0.01);
+    t.push_back(i * 0.01);
     control::TrajectorySetpoint s;
     s.p_WB = Eigen::Vector3d(0.4 * i * 0.01, 0.0, 1.0);
     s.v_WB = Eigen::Vector3d(0.4, 0.0, 0.0);
@@ -98,9 +98,9 @@ control::SetpointTrajectory along(double duration_s, double t0, const Yaw& yaw) 
 TEST(RenewedViews, KeepTheVehiclesYawAtTheSwitchAndTurnToThePlansWithinTheLimit) {
   // Flying along x with the camera at yaw 0; a plan along the same line, made for the switch at
   // t = 3 s (1.2 m along), looks at yaw 1.5 all the way.
-  const control::SetpointTrajectory current = along(10.0, 0.0, [](double) { return 0.0; });
+  const control::SetpointTrajectory current = along(10.0, [](double) { return 0.0; });
   const control::SetpointTrajectory plan = [&] {
-    control::SetpointTrajectory p = along(7.0, 0.0, [](double) { return 1.5; });
+    control::SetpointTrajectory p = along(7.0, [](double) { return 1.5; });
     std::vector<control::TrajectorySetpoint> sp = p.setpoints();
     for (control::TrajectorySetpoint& s : sp) s.p_WB.x() += 1.2;
     return control::SetpointTrajectory(p.times(), sp);
