@@ -212,10 +212,8 @@ std::optional<control::SetpointTrajectory> renewedViews(const control::SetpointT
                                                         const control::SetpointTrajectory& plan, double tau_switch,
                                                         double max_rate) {
   const std::vector<double>& t = current.times();
+  const std::vector<double>& from_t = plan.times();
   const std::vector<control::TrajectorySetpoint>& from = plan.setpoints();
-  const double dt =
-      (plan.endTime() - plan.startTime()) / static_cast<double>(std::max<std::size_t>(1, from.size() - 1));
-  const auto window = static_cast<std::size_t>(std::lround(kRenewWindowS / std::max(dt, 1e-6)));
   std::vector<double> tt;
   std::vector<control::TrajectorySetpoint> sp;
   std::size_t j = 0;  // the plan's point matched last: matches move forward along it
@@ -224,7 +222,7 @@ std::optional<control::SetpointTrajectory> renewedViews(const control::SetpointT
     control::TrajectorySetpoint s = current.setpoints()[i];
     double best = std::numeric_limits<double>::infinity();
     const std::size_t j0 = j;
-    for (std::size_t k = j0; k < std::min(from.size(), j0 + window); ++k) {
+    for (std::size_t k = j0; k < from.size() && from_t[k] < from_t[j0] + kRenewWindowS - 1e-9; ++k) {
       const double d = (from[k].p_WB - s.p_WB).squaredNorm();
       if (d < best) {
         best = d;

@@ -22,18 +22,26 @@
 namespace tgnav::harness {
 namespace {
 
-// Setpoints every 0.01 s over `duration_s`, at rest at the origin, yaw(t).
+// Setpoints every 0.01 s over `duration_s`, flying along the x axis from the origin at speed_mps
+// (0: at rest there), yaw(t).
 template <typename Yaw>
-control::SetpointTrajectory spinning(double duration_s, const Yaw& yaw) {
+control::SetpointTrajectory along(double duration_s, double speed_mps, const Yaw& yaw) {
   std::vector<double> t;
   std::vector<control::TrajectorySetpoint> sp;
   for (int i = 0; i * 0.01 <= duration_s + 1e-9; ++i) {
     t.push_back(i * 0.01);
     control::TrajectorySetpoint s;
+    s.p_WB.x() = speed_mps * i * 0.01;
+    s.v_WB.x() = speed_mps;
     s.yaw_rad = yaw(i * 0.01);
     sp.push_back(s);
   }
   return control::SetpointTrajectory(t, sp);
+}
+
+template <typename Yaw>
+control::SetpointTrajectory spinning(double duration_s, const Yaw& yaw) {
+  return along(duration_s, 0.0, yaw);
 }
 
 double maxRate(const control::SetpointTrajectory& traj) {
@@ -79,28 +87,12 @@ TEST(LimitYawRate, HoldsTheLimitFromTheSwitchOnAndRejoinsTheYaw) {
   EXPECT_EQ(limitYawRate(slow, 0.0, 0.6).setpoints().back().yaw_rad, slow.setpoints().back().yaw_rad);
 }
 
-// Setpoints every 0.01 s over `duration_s` along the x axis at 0.4 m/s from the origin, yaw(t).
-template <typename Yaw>
-control::SetpointTrajectory along(double duration_s, const Yaw& yaw) {
-  std::vector<double> t;
-  std::vector<control::TrajectorySetpoint> sp;
-  for (int i = 0; i * 0.01 <= duration_s + 1e-9; ++i) {
-    t.push_back(i * 0.01);
-    control::TrajectorySetpoint s;
-    s.p_WB = Eigen::Vector3d(0.4 * i * 0.01, 0.0, 1.0);
-    s.v_WB = Eigen::Vector3d(0.4, 0.0, 0.0);
-    s.yaw_rad = yaw(i * 0.01);
-    sp.push_back(s);
-  }
-  return control::SetpointTrajectory(t, sp);
-}
-
 TEST(RenewedViews, KeepTheVehiclesYawAtTheSwitchAndTurnToThePlansWithinTheLimit) {
   // Flying along x with the camera at yaw 0; a plan along the same line, made for the switch at
   // t = 3 s (1.2 m along), looks at yaw 1.5 all the way.
-  const control::SetpointTrajectory current = along(10.0, [](double) { return 0.0; });
+  const control::SetpointTrajectory current = along(10.0, 0.4, [](double) { return 0.0; });
   const control::SetpointTrajectory plan = [&] {
-    control::SetpointTrajectory p = along(7.0, [](double) { return 1.5; });
+    control::SetpointTrajectory p = along(7.0, 0.4, [](double) { return 1.5; });
     std::vector<control::TrajectorySetpoint> sp = p.setpoints();
     for (control::TrajectorySetpoint& s : sp) s.p_WB.x() += 1.2;
     return control::SetpointTrajectory(p.times(), sp);
