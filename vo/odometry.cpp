@@ -273,21 +273,22 @@ FrameResult RgbdOdometry::track(const PreparedFrame& frame) {
 
   applyDueAdjustment(&result);  // the bundle adjustment due now, if one is
   timeStage(clock, &FrameResult::Timing::ba_s, &result);
-  const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
-  const LocalMapMatches matches = matchLocalMap(frame, X_CW_pred);
-  timeStage(clock, &FrameResult::Timing::matching_s, &result);
+  const Attempt attempt = trackPose(frame, clock, &result);
+  const LocalMapMatches& matches = attempt.matches;
+  const PoseEstimate& pose = attempt.pose;
   result.matches = static_cast<int>(matches.object.size());
   if (result.matches < config_.min_inliers) {
     return lose(result, std::to_string(result.matches) + " matches < " + std::to_string(config_.min_inliers));
   }
-  const PoseEstimate pose = estimatePose(matches, X_CW_pred);
-  timeStage(clock, &FrameResult::Timing::pnp_s, &result);
   if (!pose.ransac_ok) {
     result.inliers = pose.ransac_inliers;
     return lose(result, std::to_string(result.inliers) + " PnP inliers < " + std::to_string(config_.min_inliers));
   }
   if (pose.inliers < 0) return lose(result, "PnP gave a non-finite pose");
   result.inliers = pose.inliers;
+  for (std::size_t m = 0; m < pose.is_inlier.size(); ++m) {
+    if (pose.is_inlier[m]) countColumn(matches.pixels[m].x, &result);
+  }
   result.status = decideStatus(pose.inliers, config_);
   if (result.status == TrackingStatus::kLost) {
     return lose(result, std::to_string(pose.inliers) + " inliers < " + std::to_string(config_.min_inliers));
@@ -317,6 +318,11 @@ void RgbdOdometry::checkImages(const cv::Mat& image, const cv::Mat& depth_m) con
     throw std::invalid_argument("depth: expected CV_32FC1 metres of " + std::to_string(camera_.width_px) + "x" +
                                 std::to_string(camera_.height_px));
   }
+}
+
+void RgbdOdometry::countColumn(double u_px, FrameResult* result) const {
+  const int bin = static_cast<int>(std::floor(u_px / camera_.width_px * FrameResult::kColumnBins));
+  ++result->inlier_columns[static_cast<std::size_t>(std::clamp(bin, 0, FrameResult::kColumnBins - 1))];
 }
 
 RgbdOdometry::PreparedFrame RgbdOdometry::prepare(double t_s, const cv::Mat& image, const cv::Mat& depth_m) const {
@@ -385,16 +391,42 @@ FrameResult RgbdOdometry::initialise(FrameResult result, const PreparedFrame& fr
   result.X_WC = X_WC_;
   result.status = TrackingStatus::kOk;
   result.inliers = result.with_depth;
+  for (std::size_t i = 0; i < frame.valid.size(); ++i) {
+    if (frame.valid[i]) countColumn(frame.features.keypoints[i].pt.x, &result);
+  }
   result.keyframe = true;
   result.keyframe_rule = "first";
   return result;
 }
 
+RgbdOdometry::Attempt RgbdOdometry::attemptPose(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred,
+                                                double radius_px, StageClock& clock, FrameResult* result) const {
+  Attempt a;
+  a.matches = matchLocalMap(frame, X_CW_pred, radius_px);
+  timeStage(clock, &FrameResult::Timing::matching_s, result);
+  if (static_cast<int>(a.matches.object.size()) >= config_.min_inliers) {
+    a.pose = estimatePose(a.matches, X_CW_pred);
+    timeStage(clock, &FrameResult::Timing::pnp_s, result);
+  }
+  return a;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::trackPose(const PreparedFrame& frame, StageClock& clock,
+                                              FrameResult* result) const {
+  const Eigen::Isometry3d X_CW_pred = predictPose().inverse();
+  Attempt a = attemptPose(frame, X_CW_pred, config_.search_radius_px, clock, result);
+  if (!config_.wide_retry || a.tracks(config_.min_inliers)) return a;
+  for (const Eigen::Isometry3d& from : {X_CW_pred, Eigen::Isometry3d(X_WC_.inverse())}) {
+    Attempt wide = attemptPose(frame, from, 2.0 * config_.search_radius_px, clock, result);
+    if (wide.tracks(config_.min_inliers)) return wide;
+  }
+  return a;  // what the prediction's own window gave: why it is lost
+}
+
 // Matches the local map's landmarks to the frame's keypoints around their predicted pixels.
 RgbdOdometry::LocalMapMatches RgbdOdometry::matchLocalMap(const PreparedFrame& frame,
-                                                          const Eigen::Isometry3d& X_CW_pred) const {
+                                                          const Eigen::Isometry3d& X_CW_pred, double radius) const {
   const Features& f = frame.features;
-  const double radius = config_.search_radius_px;
   const KeypointGrid grid(f, camera_.width_px, camera_.height_px, radius);
   const double r2 = radius * radius;
   static const NearestFn nearest = nearestForThisCpu();

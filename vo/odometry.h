@@ -58,17 +58,27 @@ inline std::vector<std::pair<std::string, KeyframePolicy>> keyframePolicyNames()
   return {{"ratio", KeyframePolicy::kRatio}, {"orbslam2", KeyframePolicy::kOrbSlam2}};
 }
 
+class StageClock;  // vo/stage_clock.h
+
 struct OdometryConfig {
   FeatureConfig features;
-  double min_depth_m = 0.2;          // features with depth outside this range have no 3D point
-  double max_depth_m = 10.0;         // the sensor's range (a RealSense D435's, configs/camera.yaml);
-                                     // BA weighs a far point's depth by its noise
-  double depth_edge_m = 0.05;        // ... nor those on a depth discontinuity (3x3 spread above
-                                     // this times the depth)
-  int init_min_features = 100;       // features with depth needed to start (or restart)
-  int min_inliers = 30;              // below: lost (ORB-SLAM2: 30 local-map inliers)
-  int weak_inliers = 60;             // below: weak
-  double search_radius_px = 24.0;    // matching window around the motion-model prediction
+  double min_depth_m = 0.2;        // features with depth outside this range have no 3D point
+  double max_depth_m = 10.0;       // the sensor's range (a RealSense D435's, configs/camera.yaml);
+                                   // BA weighs a far point's depth by its noise
+  double depth_edge_m = 0.05;      // ... nor those on a depth discontinuity (3x3 spread above
+                                   // this times the depth)
+  int init_min_features = 100;     // features with depth needed to start (or restart)
+  int min_inliers = 30;            // below: lost (ORB-SLAM2: 30 local-map inliers)
+  int weak_inliers = 60;           // below: weak
+  double search_radius_px = 24.0;  // matching window around the motion-model prediction
+  // Where the prediction tracks too few, match again in a window twice as wide around it, then
+  // around the last pose (ORB-SLAM2's TrackWithMotionModel widens its window the same way, then
+  // falls back to the reference keyframe). A quadrotor's attitude turns back within a frame or
+  // two when it stops: the constant-velocity prediction was then 40 px off and the VO lost 400-700
+  // inliers at once (docs/results/lead). A frame it tracks would have been tracked without it, so
+  // it changes nothing before the first frame that would have been lost. false: the prediction's
+  // window alone (before 2026-11-29).
+  bool wide_retry = true;
   int max_descriptor_distance = 64;  // Hamming, of 256 bits
   double ratio_test = 0.8;           // best / second best within the window
   double ransac_reprojection_px = 2.0;
@@ -101,6 +111,7 @@ struct OdometryConfig {
     a("min_inliers", min_inliers);
     a("weak_inliers", weak_inliers);
     a("search_radius_px", search_radius_px);
+    a("wide_retry", wide_retry);
     a("max_descriptor_distance", max_descriptor_distance);
     a("ratio_test", ratio_test);
     a("ransac_reprojection_px", ransac_reprojection_px);
@@ -137,7 +148,12 @@ struct FrameResult {
   int with_depth = 0;                                      // ... of which with a valid 3D point
   int matches = 0;                                         // putative matches to the local map
   int inliers = 0;                                         // PnP RANSAC inliers after refinement
-  bool keyframe = false;                                   // this frame became a keyframe
+  // Where the inliers lie across the image: their keypoints' columns in kColumnBins equal bins
+  // from the left edge (the first frame: its keypoints with depth). A turn moves them sideways,
+  // so a client can tell how many would stay in view after it (harness/run/view_guard.h).
+  static constexpr int kColumnBins = 32;
+  std::array<int, kColumnBins> inlier_columns{};
+  bool keyframe = false;      // this frame became a keyframe
   std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation);
                               // ratio: "inliers", "translation", "rotation"; orbslam2: "reference",
                               // "close"; empty for other frames
@@ -232,10 +248,18 @@ class RgbdOdometry {
   // The steps of track, in order (initialise instead of the rest for a first frame, or the
   // first after a loss with reinitialise_after_lost).
   void checkImages(const cv::Mat& image, const cv::Mat& depth_m) const;
+  void countColumn(double u_px, FrameResult* result) const;  // one inlier into inlier_columns
   FrameResult initialise(FrameResult result, const PreparedFrame& frame);
   Eigen::Isometry3d predictPose() const { return X_WC_ * velocity_; }  // constant-velocity motion model
-  LocalMapMatches matchLocalMap(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred) const;
+  LocalMapMatches matchLocalMap(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred, double radius_px) const;
   PoseEstimate estimatePose(const LocalMapMatches& matches, const Eigen::Isometry3d& X_CW_pred) const;
+  // Matching and pose from one prediction; with wide_retry, again in a window twice as wide around
+  // the prediction and then around the last pose where the first try does not track.
+  struct Attempt;
+  // (`clock` times matching and pose into `result`'s stages.)
+  Attempt attemptPose(const PreparedFrame& frame, const Eigen::Isometry3d& X_CW_pred, double radius_px,
+                      StageClock& clock, FrameResult* result) const;
+  Attempt trackPose(const PreparedFrame& frame, StageClock& clock, FrameResult* result) const;
   // Returns the keyframe rules that made the frame a keyframe (empty: not one).
   std::string updateLocalMap(const PreparedFrame& frame, const LocalMapMatches& matches, const PoseEstimate& pose);
   FrameResult lose(FrameResult result, const std::string& why);  // where a step fails

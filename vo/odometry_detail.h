@@ -31,6 +31,16 @@ struct RgbdOdometry::PoseEstimate {
   std::vector<bool> is_inlier;  // per correspondence
 };
 
+// One try at the frame's pose: its matches and the pose they give.
+struct RgbdOdometry::Attempt {
+  LocalMapMatches matches;
+  PoseEstimate pose;
+  // Whether it tracks: enough matches, RANSAC's pose, and enough inliers of the refined one.
+  bool tracks(int min_inliers) const {
+    return static_cast<int>(matches.object.size()) >= min_inliers && pose.ransac_ok && pose.inliers >= min_inliers;
+  }
+};
+
 // A local bundle adjustment: the window as it was copied, the problem solved on it, and where
 // its parts came from, so that the solution can be applied to the map by ids later.
 struct RgbdOdometry::BaJob {

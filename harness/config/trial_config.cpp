@@ -99,6 +99,8 @@ void OnlineConfig::validate() const {
   require(guard_inliers >= 1 && guard_inliers <= 10000, "guard_inliers", guard_inliers, "must be in [1, 10000]");
   require(std::isfinite(guard_range_m) && guard_range_m > 0.0 && guard_range_m <= 100.0, "guard_range_m", guard_range_m,
           "must be in (0, 100]");
+  require(std::isfinite(guard_lead_s) && guard_lead_s >= 0.0 && guard_lead_s <= 5.0, "guard_lead_s", guard_lead_s,
+          "must be in [0, 5]");
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
           "must be in [1, 100]");
   require(map_stride_px >= 1 && map_stride_px <= 64, "map_stride_px", map_stride_px, "must be in [1, 64]");

@@ -139,6 +139,10 @@ struct OnlineConfig {
   bool guard_tracking = false;
   int guard_inliers = 150;
   double guard_range_m = 3.0;
+  // > 0: the guard judges a frame by the inliers that stay in view were its turn to go on this
+  // long (harness/run/view_guard.h, GuardLead), and trips before the texture leaves the image.
+  // 0: by the inliers alone (docs/results/guard: it tripped 0.15 s before the loss).
+  double guard_lead_s = 0.0;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
   // Simulated time from take-off; beyond it the flight stops. 300 s: gallery's online flight on
@@ -170,6 +174,7 @@ struct OnlineConfig {
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);
     a("guard_range_m", guard_range_m);
+    a("guard_lead_s", guard_lead_s);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("max_flight_s", max_flight_s);

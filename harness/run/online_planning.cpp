@@ -58,11 +58,7 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +
                      ": an online trial plans again on the map it builds, whose classes change; use trial.mode prior");
   }
-  if (cfg_.guard_tracking && !external) {
-    constexpr double kGuardMinTurnRad = 5.0 * M_PI / 180.0;
-    guard_.emplace(cfg_.guard_inliers, kGuardMinTurnRad, 0.5 * scenario.planner.perception.visibility.hfov_rad,
-                   cfg_.guard_range_m);
-  }
+  if (cfg_.guard_tracking && !external) makeGuard(Intrinsics{});
   const planner::Pose4& start = scenario.scene.start;
   switch (cfg_.prior_map) {
     case PriorMap::kNone:
@@ -261,6 +257,22 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   return *current_;
 }
 
+void OnlinePlanning::makeGuard(const Intrinsics& camera) {
+  constexpr double kGuardMinTurnRad = 5.0 * M_PI / 180.0;
+  // Its lead needs the camera (before setCamera() the guard judges by the inliers alone).
+  GuardLead lead;
+  if (camera.width_px > 0) {
+    lead = GuardLead{cfg_.guard_lead_s, camera, static_cast<double>(scenario_.vo.features.edge_threshold_px)};
+  }
+  guard_.emplace(cfg_.guard_inliers, kGuardMinTurnRad, 0.5 * scenario_.planner.perception.visibility.hfov_rad,
+                 cfg_.guard_range_m, lead);
+}
+
+void OnlinePlanning::setCamera(const Intrinsics& camera) {
+  mapper_.setCamera(camera);
+  if (guard_) makeGuard(camera);
+}
+
 bool OnlinePlanning::blockedAhead(double tau_from) const {
   const double until = std::min(current_->endTime(), tau_from + kBlockedHorizonS);
   std::vector<Eigen::Vector3d> ahead;
@@ -342,12 +354,14 @@ void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double traject
   result_.map_update_s += secondsSince(t0);
 }
 
-void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const Eigen::Isometry3d& X_WC, int inliers) {
+void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame) {
   if (!guard_ || t_s < trajectory_start_s) return;
+  const Eigen::Isometry3d& X_WC = frame.X_WC;
+  const int inliers = frame.inliers;
   const Eigen::Vector3d axis = X_WC.linear().col(2);  // the optical axis
   const double yaw = std::atan2(axis.y(), axis.x());
   const double good = guard_->goodYaw();
-  const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers);
+  const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers, &frame.inlier_columns);
   if (!wedge) return;
   wedges_.push_back(*wedge);
   result_.guards.push_back(GuardEvent{t_s, yaw, good, inliers, *wedge});

@@ -29,6 +29,7 @@
 #include "harness/run/plan_run.h"
 #include "harness/run/view_guard.h"
 #include "planner/feature_map.h"
+#include "vo/odometry.h"
 
 namespace tgnav::harness {
 
@@ -120,8 +121,8 @@ class OnlinePlanning {
   // replans: it may see one.
   control::SetpointTrajectory firstPlan(PlanRun* run);
 
-  // The onboard camera, before the first keyframe.
-  void setCamera(const Intrinsics& camera) { mapper_.setCamera(camera); }
+  // The onboard camera, before the first keyframe (the map's, and the tracking guard's lead).
+  void setCamera(const Intrinsics& camera);
 
   // The trajectory to fly now (its time base is the first trajectory's).
   const control::SetpointTrajectory& trajectory() const { return *current_; }
@@ -129,10 +130,10 @@ class OnlinePlanning {
   // Maps one keyframe at frame.X_WC, and notes whether the path ahead now runs into occupied space.
   void mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s);
 
-  // The VO's result for a frame it tracked (flying on the estimate): its pose and inliers, for the
-  // tracking guard (trial.guard_tracking; view_guard.h). When it trips, the vehicle holds where its
-  // trajectory is now, the camera turned back, and a plan is due ("blind_view").
-  void trackFrame(double t_s, double trajectory_start_s, const Eigen::Isometry3d& X_WC, int inliers);
+  // The VO's result for a frame it tracked (flying on the estimate): its pose and inliers, and
+  // where they lie across the image, for the tracking guard (trial.guard_tracking; view_guard.h). When it trips, the
+  // vehicle holds where its trajectory is now, the camera turned back, and a plan is due ("blind_view").
+  void trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame);
 
   // At simulated time t: replans when one is due. Returns why the flight must stop (no route and
   // the current one blocked or spent), or an empty string.
@@ -154,6 +155,7 @@ class OnlinePlanning {
   // plan(), and where a built-in planner finds `start` within the robot radius of the map
   // (`invalid_start`), plan() again from the nearest point that clears it (record.start_shift_m).
   Attempt planClearOf(const planner::Pose4& start, double t_s, const std::string& trigger);
+  void makeGuard(const Intrinsics& camera);  // trial.guard_tracking's guard, its lead with `camera`
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
   bool goalObserved() const;

@@ -340,7 +340,7 @@ class ClosedLoop {
       if (!reinitialise_) vo_failed_known_ = true;  // among the fused results: the same in both modes
       return;
     }
-    if (online_ != nullptr) online_->trackFrame(data_->time, timeline_.trajectory_start_s, d.vo.X_WC, d.vo.inliers);
+    if (online_ != nullptr) online_->trackFrame(data_->time, timeline_.trajectory_start_s, d.vo);
     estimator_.fusePose(d.vo.t_s, d.vo.X_WC * X_CB_);
   }
 

@@ -43,9 +43,33 @@ bool inWedge(const BlindWedge& wedge, const Eigen::Vector3d& p) {
   return off <= wedge.width_rad;
 }
 
-std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers) {
+int inliersAfterTurn(const std::array<int, vo::FrameResult::kColumnBins>& columns, const vo::CameraIntrinsics& camera,
+                     double turn_rad, double edge_px) {
+  const double lo = std::atan((edge_px - camera.cx) / camera.fx);
+  const double hi = std::atan((camera.width_px - 1 - edge_px - camera.cx) / camera.fx);
+  const double bin_px = static_cast<double>(camera.width_px) / vo::FrameResult::kColumnBins;
+  int kept = 0;
+  for (int b = 0; b < vo::FrameResult::kColumnBins; ++b) {
+    const double bearing = std::atan(((b + 0.5) * bin_px - camera.cx) / camera.fx) + turn_rad;
+    if (bearing >= lo && bearing <= hi) kept += columns[static_cast<std::size_t>(b)];
+  }
+  return kept;
+}
+
+std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers,
+                                             const std::array<int, vo::FrameResult::kColumnBins>* columns) {
   recent_.emplace_back(t_s, yaw_rad);
   while (recent_.size() > 1 && recent_[1].first <= t_s - kTurnWindowS + 1e-9) recent_.pop_front();
+  const double turning = wrapAngle(yaw_rad - recent_.front().second);
+  // The turn the lead foresees, at the rate of the last kRateWindowS (a turn speeds up: the rate
+  // over the whole window saw too little of it), and the inliers it would leave in view.
+  const auto from = std::find_if(recent_.begin(), recent_.end(), [&](const std::pair<double, double>& s) {
+    return s.first >= t_s - kRateWindowS - 1e-9;
+  });
+  const double span_s = t_s - from->first;
+  const double rate = span_s > 0.0 ? wrapAngle(yaw_rad - from->second) / span_s : 0.0;
+  const double lead_rad = lead_.lead_s > 0.0 && columns != nullptr ? rate * lead_.lead_s : 0.0;
+  if (lead_rad != 0.0) inliers = std::min(inliers, inliersAfterTurn(*columns, lead_.camera, lead_rad, lead_.edge_px));
   if (inliers >= min_inliers_) {
     has_good_ = true;
     good_yaw_rad_ = yaw_rad;
@@ -53,13 +77,12 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
     rearm_ = false;
     return std::nullopt;
   }
-  const double turning = wrapAngle(yaw_rad - recent_.front().second);
   if (!armed_ || !has_good_ || std::abs(turning) < min_turn_rad_) return std::nullopt;
   armed_ = false;
   // The new part of the view: from the good view's edge on the side turned to, to the bad view's
   // far edge and kBeyondRad on.
   const double turned = std::abs(wrapAngle(yaw_rad - good_yaw_rad_));
-  const double width = std::min(M_PI, turned + kBeyondRad);
+  const double width = std::min(M_PI, turned + std::abs(lead_rad) + kBeyondRad);
   BlindWedge w;
   w.apex = p;
   w.range_m = range_m_;

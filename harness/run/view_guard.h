@@ -13,12 +13,15 @@
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <deque>
 #include <optional>
 #include <utility>
 #include <vector>
 
 #include "harness/run/plan_run.h"
+#include "vo/camera_intrinsics.h"
+#include "vo/odometry.h"
 
 namespace tgnav::harness {
 
@@ -43,20 +46,47 @@ struct GuardEvent {
   BlindWedge wedge;  // its apex: where the camera was (estimated)
 };
 
+// How many of a frame's inliers (vo::FrameResult::inlier_columns, binned across `camera`'s image)
+// stay in the image after the camera turns by turn_rad about its vertical axis (counter-clockwise,
+// as yaw, positive: the points move right), its edges moved in by edge_px (where the detector
+// finds no keypoints). Each bin counts at its centre's bearing.
+int inliersAfterTurn(const std::array<int, vo::FrameResult::kColumnBins>& columns, const vo::CameraIntrinsics& camera,
+                     double turn_rad, double edge_px);
+
+// The guard's lead (trial.guard_lead_s > 0): it judges a frame by the inliers that would stay in
+// view were the turn to go on at its rate (over the last ViewGuard::kRateWindowS) for lead_s, not by the
+// inliers alone. The reactive guard tripped 0.15 s before the loss, too late to stop the turn
+// (docs/results/guard): a turn toward bare space takes the texture out at the image's trailing
+// edge, and the inliers' columns show it coming.
+struct GuardLead {
+  double lead_s = 0.0;  // 0: the inliers alone
+  vo::CameraIntrinsics camera;
+  double edge_px = 0.0;
+};
+
 class ViewGuard {
  public:
   // How far past the bad view's far edge the wedge reaches: the turn was heading that way.
   static constexpr double kBeyondRad = M_PI / 4.0;
   // The camera turns when its yaw changed by min_turn_rad over this long.
   static constexpr double kTurnWindowS = 0.5;
+  // The lead's turn rate: over this long (three frames at 20 Hz).
+  static constexpr double kRateWindowS = 0.15;
 
   // half_fov_rad: half the camera's horizontal field of view.
-  ViewGuard(int min_inliers, double min_turn_rad, double half_fov_rad, double range_m)
-      : min_inliers_(min_inliers), min_turn_rad_(min_turn_rad), half_fov_rad_(half_fov_rad), range_m_(range_m) {}
+  ViewGuard(int min_inliers, double min_turn_rad, double half_fov_rad, double range_m, GuardLead lead = {})
+      : min_inliers_(min_inliers),
+        min_turn_rad_(min_turn_rad),
+        half_fov_rad_(half_fov_rad),
+        range_m_(range_m),
+        lead_(lead) {}
 
-  // One tracked frame: the camera's position and yaw (estimated) and the VO's inliers. Returns the
-  // blind wedge when the guard trips; it then stays disarmed until rearm().
-  std::optional<BlindWedge> observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers);
+  // One tracked frame: the camera's position and yaw (estimated) and the VO's inliers (with a
+  // lead, `columns`: where they lie across the image). Returns the blind wedge when the guard
+  // trips; it then stays disarmed until rearm(). With a lead, the wedge reaches past the bad view
+  // by the turn the lead foresaw as well.
+  std::optional<BlindWedge> observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers,
+                                    const std::array<int, vo::FrameResult::kColumnBins>* columns = nullptr);
   // Arms it again from the next frame that tracks enough (a new plan is flown).
   void rearm() { rearm_ = true; }
   bool armed() const { return armed_; }
@@ -67,6 +97,7 @@ class ViewGuard {
   double min_turn_rad_;
   double half_fov_rad_;
   double range_m_;
+  GuardLead lead_;
   bool armed_ = true;
   bool rearm_ = false;
   bool has_good_ = false;

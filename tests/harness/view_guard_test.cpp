@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "control/trajectory.h"
@@ -67,6 +69,52 @@ TEST(ViewGuard, ATurnToTheRightBlamesTheBearingsRightOfTheGoodView) {
   EXPECT_FALSE(inWedge(*r, at(right_edge + 0.05, 2.0)));                                // inside the good view
   EXPECT_FALSE(inWedge(*r, at(0.0, 1.0)));               // straight ahead of the good view
   EXPECT_FALSE(inWedge(*r, at(right_edge - 0.1, 3.5)));  // beyond its range
+}
+
+using Columns = std::array<int, vo::FrameResult::kColumnBins>;
+
+// 640 px wide, 90 deg across: fx = 320.
+vo::CameraIntrinsics camera() { return vo::CameraIntrinsics{640, 480, 320.0, 320.0, 320.0, 240.0}; }
+
+TEST(InliersAfterTurn, CountsTheInliersWhoseBearingStaysInsideTheImage) {
+  Columns c{};
+  c[0] = 7;    // centre 10 px: inside the detector's edge of 19 px already
+  c[2] = 100;  // centre 50 px: bearing atan(-270 / 320) = -40.2 deg
+  c[31] = 5;   // centre 630 px: bearing +40.2 deg
+  const vo::CameraIntrinsics k = camera();
+  EXPECT_EQ(inliersAfterTurn(c, k, 0.0, 0.0), 112);
+  EXPECT_EQ(inliersAfterTurn(c, k, 0.0, 19.0), 100);
+  // The image's left edge (19 px in) lies at atan(-301 / 320) = -43.25 deg: a turn to the right
+  // (clockwise, negative) by 2.5 deg keeps bin 2, by 3.5 deg takes it out, and brings bin 31 in
+  // from the right edge (43.15 deg); a turn to the left moves every point right.
+  EXPECT_EQ(inliersAfterTurn(c, k, -2.5 * kDeg, 19.0), 105);
+  EXPECT_EQ(inliersAfterTurn(c, k, -3.5 * kDeg, 19.0), 5);
+  EXPECT_EQ(inliersAfterTurn(c, k, 10.0 * kDeg, 19.0), 107);  // bin 0 comes inside, bin 31 leaves
+}
+
+TEST(ViewGuard, WithALeadItTripsBeforeTheTextureAtTheTrailingEdgeLeavesTheImage) {
+  // A turn to the right at 0.6 rad/s; 600 inliers, all 20-100 px from the image's left edge: the
+  // 0.36 rad the turn goes on for over a lead of 0.6 s takes every one of them out.
+  Columns crowded{};
+  for (std::size_t b = 1; b <= 4; ++b) crowded[b] = 150;
+  Columns even{};
+  for (int& n : even) n = 600 / vo::FrameResult::kColumnBins;
+  const Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  auto fly = [&](const Columns& columns, double lead_s) {
+    ViewGuard g(150, 5.0 * kDeg, kHalfFov, 3.0, GuardLead{lead_s, camera(), 19.0});
+    for (int i = 0; i <= 20; ++i) {
+      const double t = 0.05 * i;
+      if (auto w = g.observe(t, p, -0.6 * t, 600, &columns)) return std::make_pair(t, *w);
+    }
+    return std::make_pair(-1.0, BlindWedge{});
+  };
+  const auto [t_trip, w] = fly(crowded, 0.6);
+  // It trips once the turn is 5 deg over the last 0.5 s (0.15 s in), with all 600 still tracked.
+  EXPECT_NEAR(t_trip, 0.15, 1e-9);
+  // The wedge reaches past the view by the 0.36 rad the lead foresaw too.
+  EXPECT_NEAR(w.width_rad, 0.6 * 0.15 + 0.36 + ViewGuard::kBeyondRad, 1e-9);
+  EXPECT_LT(fly(even, 0.6).first, 0.0);     // texture all across: a turn keeps most of it
+  EXPECT_LT(fly(crowded, 0.0).first, 0.0);  // no lead: the inliers alone, still 600
 }
 
 TEST(BlockWedges, MarksOnlyUnknownSpaceInsideTheWedgeAwayFromKeptPlaces) {

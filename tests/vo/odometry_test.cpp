@@ -58,6 +58,52 @@ TEST(Odometry, TracksASidewaysSlideOverATexturedPlane) {
   EXPECT_GT(vo.history().back().features, 500);
 }
 
+// The inliers' columns (FrameResult::inlier_columns) count every inlier, in the bin of the part
+// of the image it lies in: texture on the left half only leaves the right half's bins empty.
+TEST(Odometry, CountsTheInliersColumnsWhereTheTextureIs) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  RgbdOdometry vo(camera(), OdometryConfig{});
+  for (int i = 0; i < 10; ++i) {
+    cv::Mat image = tex(cv::Rect(4 * i, 0, kW, kH)).clone();
+    image(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(128));
+    const FrameResult r = vo.track(0.05 * i, image, flatDepth());
+    ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+    int sum = 0;
+    for (const int n : r.inlier_columns) sum += n;
+    EXPECT_EQ(sum, r.inliers) << "frame " << i;
+    EXPECT_GT(r.inliers, 100) << "frame " << i;
+    const int half = FrameResult::kColumnBins / 2;
+    for (int b = half + 1; b < FrameResult::kColumnBins; ++b) {
+      EXPECT_EQ(r.inlier_columns[static_cast<std::size_t>(b)], 0) << "frame " << i << ", bin " << b;
+    }
+  }
+}
+
+// A jerk the motion model does not foresee: the image slides 4 px a frame, then 40 px back in one
+// frame (44 px from the prediction, beyond the 24 px window). Without wide_retry the frame is
+// lost; with it (the default) the wider window finds the landmarks and the pose follows the jump.
+TEST(Odometry, AWideRetryTracksAJerkTheMotionModelMissed) {
+  const cv::Mat tex = texture(kW + 400, kH);
+  for (const bool retry : {false, true}) {
+    OdometryConfig config;
+    config.wide_retry = retry;
+    RgbdOdometry vo(camera(), config);
+    FrameResult r;
+    for (int i = 0; i <= 10; ++i) {
+      const int offset = i < 10 ? 100 + 4 * i : 136 - 40;
+      r = vo.track(0.05 * i, tex(cv::Rect(offset, 0, kW, kH)).clone(), flatDepth());
+      if (i < 10) ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+    }
+    if (!retry) {
+      EXPECT_EQ(r.status, TrackingStatus::kLost);
+      continue;
+    }
+    ASSERT_NE(r.status, TrackingStatus::kLost) << r.reason;
+    EXPECT_GE(r.inliers, 200);
+    EXPECT_NEAR(r.X_WC.translation().x(), -4.0 * kDepth / kF, 0.01);  // 96 px from where it started
+  }
+}
+
 // Bundle adjustment runs on keyframes (at each with ba.every_keyframes = 1; not on the first,
 // which has nothing to adjust against) and reports what it changed there; with ba.enabled =
 // false nothing is reported. Both track the slide; on exact depth BA's corrections are small.
