@@ -141,7 +141,8 @@ struct OnlineConfig {
   double guard_range_m = 3.0;
   // > 0: the guard judges a frame by the inliers that stay in view were its turn to go on this
   // long (harness/run/view_guard.h, GuardLead), and trips before the texture leaves the image.
-  // 0: by the inliers alone (docs/results/guard: it tripped 0.15 s before the loss).
+  // 0: by the inliers alone (docs/results/guard: it tripped 0.15 s before the loss). Measured at
+  // 0.6 s and left off: storage never lost the VO, but 8 of 10 flights stalled (docs/results/lead).
   double guard_lead_s = 0.0;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
