@@ -111,6 +111,11 @@ void PoseGraphConfig::validate() const {
   require(turn_substeps >= 1 && turn_substeps <= 16, "turn_substeps", turn_substeps, "must be in [1, 16]");
   require(max_between_rounds >= 1, "max_between_rounds", max_between_rounds, "must be >= 1");
   require(std::isfinite(failure_weight) && failure_weight >= 0.0, "failure_weight", failure_weight, "must be >= 0");
+  require(std::isfinite(look_unknown_m) && look_unknown_m >= 0.0, "look_unknown_m", look_unknown_m, "must be >= 0");
+}
+
+double lookAheadHalfFov(const VisibilityConfig& visibility) {
+  return std::max(0.0, 0.5 * visibility.hfov_rad - 10.0 * M_PI / 180.0);
 }
 
 DagPath shortestLayeredPath(const LayeredDag& dag) {
@@ -198,7 +203,6 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
   std::vector<std::vector<WeightedPoint>> layer_seen(static_cast<std::size_t>(layers));
   // What the camera sees around a layer (V of its path point, any yaw): the image coverage of
   // InformationConfig::min_image_coverage is the camera's, not the co-visible set's.
-  const bool gate = information.usesImageCells();
   const bool inner = information.usesInnerDetections();
   static const std::vector<WeightedPoint> kNone;
   auto segmentAt = [&](double s) {
@@ -240,10 +244,48 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
           : StartTurn{std::vector<bool>(static_cast<std::size_t>(yaws), true),
                       std::vector<double>(static_cast<std::size_t>(yaws), 0.0)};
 
+  // The look-ahead's way ahead of each layer (look_unknown_m): the path point look_unknown_m on,
+  // where it or the one half as far is unobserved; NaN where the layer keeps its own yaws.
+  const double half_fov = lookAheadHalfFov(visibility);
+  std::vector<Eigen::Vector3d> way_ahead(static_cast<std::size_t>(layers),
+                                         Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  // The yaw the look-ahead flies at p for a pose of layer j with yaw `yaw`.
+  auto flownYaw = [&](int j, const Eigen::Vector3d& p, double yaw) {
+    const Eigen::Vector3d& far = way_ahead[static_cast<std::size_t>(j)];
+    if (std::isnan(far.x())) return yaw;
+    const Eigen::Vector2d way = (far - p).head<2>();
+    if (way.norm() < kLookAheadMinWayM) return yaw;
+    const double heading = std::atan2(way.y(), way.x());
+    const double off = wrapAngle(yaw - heading);
+    return std::abs(off) <= half_fov ? yaw : wrapAngle(heading + std::copysign(half_fov, off));
+  };
+  // A view's score and support from camera pose (p, yaw): the landmarks `points` (a segment's
+  // co-visible set) for the information, `seen` (the camera's V near it) for the image coverage.
+  const bool gate = information.usesImageCells();
+  auto viewAt = [&](const Eigen::Vector3d& p, double yaw, const std::vector<WeightedPoint>& points,
+                    const std::vector<WeightedPoint>& seen, ViewSupport* backing) {
+    const Eigen::Vector3d c = cameraPosition(p, yaw, visibility);
+    const Matrix6d info = poseInformation(c, yaw, points, visibility, information, backing);
+    if (gate) {
+      backing->cells = 0;
+      const ImageCells cell(yaw, visibility);
+      const FieldOfView in_view(yaw, visibility);
+      for (const WeightedPoint& pt : seen) {
+        if (in_view(c, pt.p_W) && withinIncidence(c, pt, information)) backing->cover(cell(c, pt.p_W));
+      }
+    }
+    return scoreInformation(info, *backing, information);
+  };
+
   for (int j = 0; j < layers; ++j) {
     const double s = j == layers - 1 ? length : spacing * j;
     result.layer_s[static_cast<std::size_t>(j)] = s;
     const Eigen::Vector3d centre = pointAt(path, s);
+    if (config.look_unknown_m > 0.0 && j > 0) {
+      const Eigen::Vector3d far = pointAt(path, std::min(length, s + config.look_unknown_m));
+      const Eigen::Vector3d near = pointAt(path, std::min(length, s + 0.5 * config.look_unknown_m));
+      if (!voxels.observed(far) || !voxels.observed(near)) way_ahead[static_cast<std::size_t>(j)] = far;
+    }
     std::vector<Eigen::Vector3d> candidates{centre};
     if (j > 0 && j < layers - 1) {
       Eigen::Vector3d e1, e2;
@@ -336,9 +378,19 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
         forYawsHolding(
             pt, [&](std::size_t idx, const Eigen::Vector3d& c) { support[idx].cover(cells_of[idx](c, pt.p_W)); });
       }
+      // The look-ahead turns a node's camera to one of the window's two edges: those views, once.
+      std::map<double, std::pair<double, ViewSupport>> turned;
       for (int k = 0; k < yaws; ++k) {
-        const ViewSupport& backing = support[static_cast<std::size_t>(k)];
-        const double score = scoreInformation(info[static_cast<std::size_t>(k)], backing, information);
+        const auto ku = static_cast<std::size_t>(k);
+        const double flown = flownYaw(j, p, yaw_of[ku]);
+        if (flown != yaw_of[ku] && turned.count(flown) == 0) {
+          ViewSupport view;
+          const double score = viewAt(p, flown, points, seen, &view);
+          turned.emplace(flown, std::make_pair(score, view));
+        }
+        const bool turns = flown != yaw_of[ku];
+        const ViewSupport& backing = turns ? turned.at(flown).second : support[ku];
+        const double score = turns ? turned.at(flown).first : scoreInformation(info[ku], backing, information);
         const bool allowed = j != 0 || (free_start ? turn.ok[static_cast<std::size_t>(k)] : k == 0);
         layer_scores.push_back(score);
         double cost = -config.perception_weight * rankedScore(score, backing, information) / layers;
@@ -396,22 +448,11 @@ PoseGraphResult searchPoseGraph(const std::vector<Eigen::Vector3d>& path, const 
     for (int i = 1; i <= config.between_checks; ++i) {
       const double f = static_cast<double>(i) / (config.between_checks + 1);
       const Eigen::Vector3d p = (1.0 - f) * pa + f * pb;
-      const double yaw = wrapAngle(ya + f * turn);
       const double s = (1.0 - f) * result.layer_s[ju] + f * result.layer_s[ju + 1];
-      const Eigen::Vector3d c = cameraPosition(p, yaw, visibility);
+      const std::size_t nearer = 2 * i <= config.between_checks + 1 ? ju : ju + 1;
+      const double yaw = flownYaw(static_cast<int>(nearer), p, wrapAngle(ya + f * turn));
       ViewSupport backing;
-      const Matrix6d info = poseInformation(c, yaw, pointsOf(segmentAt(s)), visibility, information, &backing);
-      if (gate) {
-        backing.cells = 0;
-        const ImageCells cell(yaw, visibility);
-        const FieldOfView in_view(yaw, visibility);
-        for (const WeightedPoint& pt : layer_seen[2 * i <= config.between_checks + 1 ? ju : ju + 1]) {
-          if (in_view(c, pt.p_W) && withinIncidence(c, pt, information)) {
-            backing.cover(cell(c, pt.p_W));
-          }
-        }
-      }
-      const double score = scoreInformation(info, backing, information);
+      const double score = viewAt(p, yaw, pointsOf(segmentAt(s)), layer_seen[nearer], &backing);
       if (!isBlind(score)) continue;
       const double ranked = rankedScore(score, backing, information);
       if (!(ranked >= lowest)) lowest = ranked;  // also replaces NaN

@@ -94,6 +94,18 @@ struct PoseGraphConfig {
   // a model. Tried at 1 (docs/results/premise/inner): the premise benchmark held, but the
   // generalisation benchmark lost one scene more than at 0, so it is off.
   double failure_weight = 0.0;
+  // The views the look-ahead flies (ours; online planning, trial.plan_look_ahead). An online trial
+  // turns the camera toward the way ahead wherever that runs through space the map has not
+  // observed (trial.look_ahead_s; harness/run/look_ahead.h), whatever yaw the plan chose, so a plan
+  // that rates a route by the yaws it chose rates views that are not flown (detour-1001 online: the
+  // straight route rated blind for 4.1 m, from views looking back at the mapped wall, while the
+  // camera flew looking ahead into bare space). With look_unknown_m > 0, a layer (the first, the
+  // vehicle's own yaw, excepted) whose path point look_unknown_m further on, or half that far, is
+  // unobserved scores each node at the yaw that rule flies: its own, turned as little as keeps the
+  // way ahead (the path point look_unknown_m on) within lookAheadHalfFov() of the camera's axis;
+  // so do the moves between layers. The path keeps the lattice's yaws (the trial's rule turns them).
+  // 0 (default): every node at its own yaw, as the paper.
+  double look_unknown_m = 0.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -113,10 +125,17 @@ struct PoseGraphConfig {
     a("between_checks", between_checks);
     a("max_between_rounds", max_between_rounds);
     a("failure_weight", failure_weight);
+    a("look_unknown_m", look_unknown_m);
   }
 
   void validate() const;
 };
+
+// How far off the camera's axis the look-ahead keeps the way ahead: 10 deg inside the edge of the
+// horizontal field of view (never below 0).
+double lookAheadHalfFov(const VisibilityConfig& visibility);
+// ... and leaves the yaw alone where the way ahead lies closer than this (horizontally).
+constexpr double kLookAheadMinWayM = 0.1;
 
 // A DAG in layers: every edge goes from layer j to layer j + 1. A path starts anywhere in the
 // first layer and ends anywhere in the last; its cost is the sum of its node and edge costs.

@@ -25,6 +25,7 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
   origin_ = lo * res_;
   size_ = (hi - lo).cast<int>().cwiseMax(1);
   state_.assign(static_cast<std::size_t>(size_.prod()), unknown_free ? VoxelState::kFree : VoxelState::kUnknown);
+  observed_.assign(state_.size(), false);
 
   const octomap::OcTree& tree = map.occupancy();
   const octomap::point3d bmin(static_cast<float>(origin_.x()), static_cast<float>(origin_.y()),
@@ -41,7 +42,10 @@ VoxelMap::VoxelMap(const FeatureMap& map, const Eigen::Vector3d& min_W, const Ei
         cellOf(c + Eigen::Vector3d::Constant(half - 0.5 * res_)).cwiseMin(size_ - Eigen::Vector3i::Ones());
     for (int z = a.z(); z <= b.z(); ++z) {
       for (int y = a.y(); y <= b.y(); ++y) {
-        for (int x = a.x(); x <= b.x(); ++x) state_[static_cast<std::size_t>(flat(x, y, z))] = s;
+        for (int x = a.x(); x <= b.x(); ++x) {
+          state_[static_cast<std::size_t>(flat(x, y, z))] = s;
+          observed_[static_cast<std::size_t>(flat(x, y, z))] = true;
+        }
       }
     }
   }
@@ -90,6 +94,11 @@ Eigen::Vector3d VoxelMap::centreOf(int index) const {
 VoxelState VoxelMap::state(const Eigen::Vector3d& p_W) const {
   const Eigen::Vector3i c = cellOf(p_W);
   return inside(c) ? state_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))] : VoxelState::kUnknown;
+}
+
+bool VoxelMap::observed(const Eigen::Vector3d& p_W) const {
+  const Eigen::Vector3i c = cellOf(p_W);
+  return inside(c) && observed_[static_cast<std::size_t>(flat(c.x(), c.y(), c.z()))];
 }
 
 bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {

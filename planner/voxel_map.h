@@ -49,6 +49,9 @@ class VoxelMap {
   Eigen::Vector3i size() const { return size_; }
   Eigen::Vector3d origin() const { return origin_; }  // corner of voxel (0, 0, 0)
   VoxelState state(const Eigen::Vector3d& p_W) const;
+  // Whether p's voxel was observed (free or occupied in the octree), whatever `unknown_free` made
+  // of it for collision; false outside the box.
+  bool observed(const Eigen::Vector3d& p_W) const;
   const std::vector<LandmarkVoxel>& landmarkVoxels() const { return landmark_voxels_; }
   // Index into landmarkVoxels() of landmark `id` (-1: outside the box).
   int landmarkSlot(int id) const { return landmark_slot_.at(static_cast<std::size_t>(id)); }
@@ -111,6 +114,7 @@ class VoxelMap {
   Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
   Eigen::Vector3i size_ = Eigen::Vector3i::Zero();
   std::vector<VoxelState> state_;
+  std::vector<bool> observed_;  // per voxel: a leaf of the octree covers it
   // Distance field over voxel layers [edt_z0_, edt_z0_ + edt_nz_), padded by one voxel on every
   // side (obstacles where the padding lies outside the box, free where it is only outside the band).
   int edt_z0_ = 0;

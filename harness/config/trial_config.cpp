@@ -103,6 +103,8 @@ void OnlineConfig::validate() const {
           "must be in [0, 5]");
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
           "must be in [1, 100]");
+  require(std::isfinite(map_range_m) && map_range_m > 0.0 && map_range_m <= 100.0, "map_range_m", map_range_m,
+          "must be in (0, 100]");
   require(map_stride_px >= 1 && map_stride_px <= 64, "map_stride_px", map_stride_px, "must be in [1, 64]");
   require(std::isfinite(max_flight_s) && max_flight_s > 0.0 && max_flight_s <= 3600.0, "max_flight_s", max_flight_s,
           "must be in (0, 3600]");

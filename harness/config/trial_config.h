@@ -117,6 +117,19 @@ struct OnlineConfig {
   // (the least turn at a tie; harness/run/look_ahead.h, bestViewOffset). Not with
   // look_ahead_keeps_tracking.
   bool look_ahead_best_view = false;
+  // With proposed, its pose graph scores each view where the way ahead is unknown at the yaw the
+  // look-ahead flies there (planner.pose_graph.look_unknown_m set to look_ahead_s times the
+  // trajectory's nominal speed; planner/pose_graph.h), so that a plan rates the views it flies.
+  // false: at the yaws it chose, which the look-ahead then turns. Measured and left off: storage
+  // 5/10 and gallery 0/10 against 9/10 and 1/10 (docs/results/first_look): from no map, every view
+  // into unknown space rates blind, and the least blind route is the one with the least unknown.
+  bool plan_look_ahead = false;
+  // The vehicle climbs and holds its start pose, mapping what its camera sees, until the first
+  // replan period, and the first plan it flies is made then; the plan made before take-off, on the
+  // prior map alone (from no map: an empty one), is recorded but not flown. false: that plan is flown.
+  // Measured on the premise scenes and left off: the VO was still lost in the first turn (median
+  // 4.3 s, 0/16; docs/results/first_look).
+  bool hold_first_plan = false;
   // The built-in planners' trajectories end at rest before their path first comes within the robot
   // radius and two voxels of space unknown when planned (0.5 m on at least), the camera turned to
   // see the way on; the next plan, made once the map has grown, sends the vehicle on
@@ -146,6 +159,13 @@ struct OnlineConfig {
   double guard_lead_s = 0.0;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
+  // Depth within this range goes into the map, and the features there become landmarks: the
+  // survey's range (MapBuildConfig::max_range_m, 6 m: RGB-D noise grows as z^2). The VO tracks
+  // features up to vo.max_depth_m (10 m) and the planners count them that far
+  // (planner.perception.visibility.max_range_m), so texture between the two is tracked but never
+  // mapped online: from the premise scenes' starts, a median of 24 landmarks mapped in 2 s against
+  // 591 at 10 m. Measured at 10 m and left at 6: storage 3/10 against 9/10 (docs/results/first_look).
+  double map_range_m = 6.0;
   // Simulated time from take-off; beyond it the flight stops. 300 s: gallery's online flight on
   // the true pose alone took 115 s for its 38 m (docs/results/online10/truth), so 120 s stopped
   // flights that were still tracking and making way.
@@ -170,6 +190,8 @@ struct OnlineConfig {
     a("look_ahead_always", look_ahead_always);
     a("look_ahead_keeps_tracking", look_ahead_keeps_tracking);
     a("look_ahead_best_view", look_ahead_best_view);
+    a("plan_look_ahead", plan_look_ahead);
+    a("hold_first_plan", hold_first_plan);
     a("stop_before_unknown", stop_before_unknown);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
@@ -178,6 +200,7 @@ struct OnlineConfig {
     a("guard_lead_s", guard_lead_s);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
+    a("map_range_m", map_range_m);
     a("max_flight_s", max_flight_s);
   }
 

@@ -123,7 +123,7 @@ control::SetpointTrajectory lookWhereUnknown(const control::SetpointTrajectory& 
     const Eigen::Vector3d far = trajectory.sample(t[i] + look_ahead_s).p_WB;
     const Eigen::Vector3d near = trajectory.sample(t[i] + 0.5 * look_ahead_s).p_WB;
     const Eigen::Vector2d way = (far - sp[i].p_WB).head<2>();
-    if (way.norm() < 0.1 || (!always && map.isKnown(far) && map.isKnown(near))) continue;
+    if (way.norm() < planner::kLookAheadMinWayM || (!always && map.isKnown(far) && map.isKnown(near))) continue;
     // The least turn from the planner's yaw that keeps the way ahead in the camera's field of view.
     const double heading = std::atan2(way.y(), way.x());
     const double planned = sp[i].yaw_rad;
@@ -267,7 +267,7 @@ control::SetpointTrajectory limitYawRate(const control::SetpointTrajectory& traj
 }
 
 double lookAheadHalfFov(const planner::PerceptionPlannerConfig& perception) {
-  return std::max(0.0, 0.5 * perception.visibility.hfov_rad - 10.0 * M_PI / 180.0);
+  return planner::lookAheadHalfFov(perception.visibility);
 }
 
 control::SetpointTrajectory holdTrajectory(const planner::Pose4& pose, double duration_s, double rate_hz) {

@@ -28,9 +28,10 @@ constexpr double kBlockedStepS = 0.1;
 // where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
 constexpr double kSameRouteM = 0.75;
 
-MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey) {
+MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const OnlineConfig& online) {
   MapBuildConfig config;
   config.resolution_m = survey.resolution();
+  config.max_range_m = online.map_range_m;
   return config;
 }
 
@@ -52,7 +53,7 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
       planner_(planner),
       seed_(seed),
       rrt_samples_(rrt_samples),
-      mapper_(onlineMapConfig(survey)),
+      mapper_(onlineMapConfig(survey, scenario.trial.online)),
       external_(external ? std::make_unique<ExternalPlannerSession>() : nullptr) {
   if (scenario.planner.oracle_class >= 0) {
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +
@@ -120,8 +121,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
         addUnseenPrior(&built.map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
   }
   a.record.snapshot_s = secondsSince(t0);
-  Scenario from_here = scenario_;
-  from_here.scene.start = start;
+  const Scenario from_here = planningScenario(start);
   const double rate_hz = scenario_.planner.trajectory.sample_rate_hz;
   if (external_) {
     if (!askExternal(from_here, built.map, &a)) return a;
@@ -233,22 +233,33 @@ bool OnlinePlanning::goalObserved() const {
          nullptr;
 }
 
+Scenario OnlinePlanning::planningScenario(const planner::Pose4& start) const {
+  Scenario from_here = scenario_;
+  from_here.scene.start = start;
+  if (cfg_.plan_look_ahead) {
+    from_here.planner.perception.graph.look_unknown_m =
+        cfg_.look_ahead_s * scenario_.planner.trajectory.nominal_speed_mps;
+  }
+  return from_here;
+}
+
 control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   goal_seen_ = goalObserved();  // a prior map may have it
   planner::Pose4 start = scenario_.scene.start;
   Attempt a = plan(start, 0.0, "start");
   next_replan_s_ = cfg_.replan_period_s;
-  if (a.trajectory) {
+  if (a.trajectory && cfg_.hold_first_plan) a.record.detail = "not flown: trial.hold_first_plan";
+  if (a.trajectory && !cfg_.hold_first_plan) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
   } else {
-    // No route yet: climb to the flight height and look.
+    // No route yet, or none to fly yet (hold_first_plan): climb to the flight height and look.
     start.p_WB.z() = scenario_.scene.flight_height_m;
     current_ = std::make_unique<control::SetpointTrajectory>(
         holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()));
-    failed_in_a_row_ = 1;
+    failed_in_a_row_ = a.trajectory ? 0 : 1;
     holding_ = true;
   }
   tau0_ = current_->startTime();

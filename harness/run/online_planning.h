@@ -118,7 +118,7 @@ class OnlinePlanning {
   // The plan before take-off, from the scene's start on the prior map, into *run (its voxels
   // stay there for the trial's per-frame predictions). Without a route, the vehicle climbs to the
   // start's flight height and holds there for a replan period (the returned trajectory) and
-  // replans: it may see one.
+  // replans: it may see one. So it does with trial.hold_first_plan, the plan recorded, not flown.
   control::SetpointTrajectory firstPlan(PlanRun* run);
 
   // The onboard camera, before the first keyframe (the map's, and the tracking guard's lead).
@@ -150,6 +150,8 @@ class OnlinePlanning {
  private:
   struct Attempt;
   Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
+  // The scenario a plan from `start` is made in (with plan_look_ahead, the pose graph's look_unknown_m).
+  Scenario planningScenario(const planner::Pose4& start) const;
   // Why a plan is asked now ("blind_view", "blocked", "goal_seen" or "period"); clears the events.
   std::string takeTrigger();
   // plan(), and where a built-in planner finds `start` within the robot radius of the map

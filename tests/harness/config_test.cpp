@@ -403,6 +403,9 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.guard_range_m = 0.0;
   EXPECT_EQ(invalidArgument(t), "guard_range_m = 0: must be in (0, 100]");
   t = TrialConfig{};
+  t.online.map_range_m = 0.0;
+  EXPECT_EQ(invalidArgument(t), "map_range_m = 0: must be in (0, 100]");
+  t = TrialConfig{};
   t.online.look_ahead_best_view = true;
   EXPECT_EQ(invalidArgument(t), "");
   t.online.look_ahead_keeps_tracking = true;

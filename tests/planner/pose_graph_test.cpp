@@ -810,6 +810,60 @@ TEST(PoseGraph, YawCanTurnOnEveryPathWhenTheConfigValidates) {
   EXPECT_GT(a.edges, b.edges) << "7 m path, 21 yaw samples: the yaw cannot change between any two layers";
 }
 
+// A textured wall at the west end (x = 0.3, facing east), the rest bare. The world is observed up
+// to x = 6; the voxel map reaches x = 10, and the space beyond 6 is unknown (free for the search,
+// as an online plan sees it). The path runs east from x = 1 to x = 8, into the unknown, from a
+// start that faces the wall.
+TEST(PoseGraph, WhereTheWayAheadIsUnknownItScoresTheViewTheLookAheadFlies) {
+  testing::SyntheticWorld w;
+  w.min_W = {0.0, 0.0, 0.0};
+  w.max_W = {6.0, 3.0, 2.5};
+  const Eigen::AlignedBox3d wall(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.3, 3.0, 2.5));
+  w.solids = {wall};
+  w.texture(wall, Eigen::Vector3d(1, 0, 0), 0.1);
+  const FeatureMap map = w.build();
+  const VoxelMap voxels(map, w.min_W, Eigen::Vector3d(10.0, 3.0, 2.5), -1e9, 1e9, /*unknown_free=*/true);
+  EXPECT_TRUE(voxels.observed({5.9, 1.5, kZ}));
+  EXPECT_FALSE(voxels.observed({6.1, 1.5, kZ}));
+  EXPECT_EQ(voxels.state({6.1, 1.5, kZ}), VoxelState::kFree);  // unknown, free for collision
+  const std::vector<Eigen::Vector3d> path{{1.0, 1.5, kZ}, {8.0, 1.5, kZ}};
+  const VisibilityConfig vis;
+  const std::vector<PathSegment> segments = extractSegments(
+      path, SegmentConfig{}, [&](const Eigen::Vector3d& p) { return voxels.visibleSlots(p, vis); }, nullptr,
+      [&](int slot) { return voxels.landmarksIn(slot); });
+  PoseGraphConfig config;
+  const PoseGraphResult own = searchPoseGraph(path, segments, voxels, vis, syntheticInformation(), config, M_PI, 1);
+  config.look_unknown_m = 0.8;
+  const PoseGraphResult look = searchPoseGraph(path, segments, voxels, vis, syntheticInformation(), config, M_PI, 1);
+  ASSERT_TRUE(own.found);
+  ASSERT_TRUE(look.found);
+  ASSERT_EQ(own.scores.size(), look.scores.size());
+  const double blind = logDetInformation(Matrix6d::Zero(), syntheticInformation().epsilon);
+  int looking = 0;
+  for (std::size_t j = 1; j + 1 < look.scores.size(); ++j) {
+    const double x = pointAt(path, look.layer_s[j]).x();
+    // At their own yaws the poses face the wall behind them, all the way.
+    EXPECT_GT(own.scores[j], blind + 1.0) << "layer " << j << " at x " << x;
+    if (x + 0.8 + 0.1 < 6.0) {
+      // The way ahead is observed: nothing turns, and the graph faces the wall as before.
+      EXPECT_GT(look.scores[j], blind + 1.0) << "layer " << j << " at x " << x;
+    } else if (x + 0.4 > 6.0 + 0.1) {
+      // The look-ahead turns the camera within 27.6 deg of east, away from the only texture.
+      EXPECT_LE(look.scores[j], blind + 1e-9) << "layer " << j << " at x " << x;
+      ++looking;
+    }
+  }
+  EXPECT_GE(looking, 4);
+  // The yaws stay on the lattice and within the rate limit; the look-ahead turns them when flown.
+  for (std::size_t j = 1; j < look.path.size(); ++j) {
+    EXPECT_LE(std::abs(wrap(look.path[j].yaw_rad - look.path[j - 1].yaw_rad)),
+              config.yaw_rate_limit_rad_s * config.time_step_s + 1e-9);
+  }
+  EXPECT_NEAR(lookAheadHalfFov(vis), 0.5 * vis.hfov_rad - 10.0 * M_PI / 180.0, 1e-12);
+  std::cout << "[ figure   ] into unknown space: c_p " << own.c_p << " at the graph's own yaws, " << look.c_p
+            << " at the look-ahead's (" << looking << " layers look ahead)\n";
+}
+
 void expectRejected(const PoseGraphConfig& config, const std::string& field) {
   try {
     config.validate();
@@ -853,6 +907,9 @@ TEST(PoseGraph, ConfigValidationNamesTheField) {
   expectRejected(c, "turn_substeps");
   c.turn_substeps = 16;
   EXPECT_NO_THROW(c.validate());
+  c = PoseGraphConfig{};
+  c.look_unknown_m = -0.1;
+  expectRejected(c, "look_unknown_m");
 }
 
 }  // namespace

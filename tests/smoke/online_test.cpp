@@ -175,6 +175,36 @@ TEST(OnlineTrial, TheMeanPriorForUnseenSurfacesAddsLandmarksOnceSurfacesHaveBeen
   for (const nlohmann::json& p : blind) EXPECT_EQ(p["prior_landmarks"], 0);
 }
 
+TEST(OnlineTrial, HoldingTheFirstPlanFliesTheOneMadeOnWhatTheCameraMappedAndTheRangeBoundsTheMap) {
+  // trial.hold_first_plan: the plan made at take-off, on an empty map, is recorded but not flown;
+  // the vehicle climbs and holds, and the plan of the first replan period, made on what its camera
+  // mapped meanwhile, is flown. trial.map_range_m: depth beyond it is not mapped, nor are the
+  // features there.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall + " --set trial.max_flight_s=2.5";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "plain").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.hold_first_plan=true --out " + (dir / "hold").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.map_range_m=0.5 --out " + (dir / "near").string())).rc, 0);
+  const nlohmann::json plain = readJson(dir / "plain/online.json")["plans"];
+  const nlohmann::json hold = readJson(dir / "hold/online.json")["plans"];
+  const nlohmann::json near = readJson(dir / "near/online.json")["plans"];
+  ASSERT_GE(plain.size(), 2U);
+  ASSERT_GE(hold.size(), 2U);
+  ASSERT_GE(near.size(), 2U);
+  EXPECT_TRUE(plain[0]["adopted"].get<bool>());
+  EXPECT_TRUE(plain[0]["ok"].get<bool>());
+  EXPECT_TRUE(hold[0]["ok"].get<bool>());
+  EXPECT_FALSE(hold[0]["adopted"].get<bool>());
+  EXPECT_EQ(hold[0]["detail"], "not flown: trial.hold_first_plan");
+  EXPECT_EQ(hold[0]["landmarks"], 0);
+  EXPECT_TRUE(hold[1]["adopted"].get<bool>());  // the first plan flown
+  EXPECT_GT(hold[1]["landmarks"].get<int>(), 0);
+  std::cout << "[ figure   ] plan at " << plain[1]["t_s"] << " s: " << plain[1]["landmarks"]
+            << " landmarks mapped within 6 m, " << near[1]["landmarks"] << " within 0.5 m\n";
+  EXPECT_GT(plain[1]["landmarks"].get<int>(), 0);
+  EXPECT_LT(near[1]["landmarks"].get<int>(), plain[1]["landmarks"].get<int>());
+}
+
 TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
   const auto dir = test::tempDir();
   // The example A* planner behind a guard that makes a second start of the command fail.
