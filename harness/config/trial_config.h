@@ -121,8 +121,8 @@ struct OnlineConfig {
   // look-ahead flies there (planner.pose_graph.look_unknown_m set to look_ahead_s times the
   // trajectory's nominal speed; planner/pose_graph.h), so that a plan rates the views it flies.
   // false: at the yaws it chose, which the look-ahead then turns. Measured and left off: storage
-  // 5/10 and gallery 0/10 against 9/10 and 1/10 (docs/results/first_look): from no map, every view
-  // into unknown space rates blind, and the least blind route is the one with the least unknown.
+  // 5/10 and gallery 0/10 against 9/10 and 1/10 (docs/results/first_look); likely because, from no
+  // map, a view into unknown space has nothing mapped in it and rates blind.
   bool plan_look_ahead = false;
   // The vehicle climbs and holds its start pose, mapping what its camera sees, until the first
   // replan period, and the first plan it flies is made then; the plan made before take-off, on the
