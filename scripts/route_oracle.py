@@ -1,31 +1,41 @@
 #!/usr/bin/python3
-"""Can a vehicle that must see where it flies keep its VO to the goal? An oracle on a generated
-scene's true layout (`generated.json` of `tgnav scene generate`), in the plane of the flight height.
+"""Can a vehicle that must see where it flies keep its VO to the goal? An oracle on a scene's true
+layout, in the plane of the flight height: a generated scene (`generated.json` of `tgnav scene
+generate`) or a scene file of configs/scenes with its MJCF.
 
-The model (every block of a generated scene is full height, so the plane is exact for geometry):
+The model:
+- The blocks: a generated scene's surfaces (all full height, so the plane is exact), or the MJCF's
+  axis-aligned box and cylinder geoms that reach into the flight height +- 0.3 m (the planners'
+  slice). A generated block is textured when rich or medium; a geom when its material has a texture
+  from a file (colours and builtin checkers are plain).
 - A view (a cell, a yaw) *tracks* when at least `--share` of its rays across the camera's field of
-  view (75 deg) end, within the VO's depth range, on a rich or medium block. This is the rule the
-  detour generator builds its premise with (harness/scenes/layout_detour.cpp: a third of the view).
+  view (75 deg) end, within the VO's depth range, on a textured block. A third is the rule the
+  detour generator builds its premise with (harness/scenes/layout_detour.cpp). `--check-views`
+  measures the rule against the VO's frames of flown trials.
 - A view *observes* the cells along its rays up to the first block or the mapper's range
   (`trial.map_range_m`, 6 m): they become known free.
-- The vehicle moves between neighbouring cells, with its clearance (the planners' robot radius),
-  keeping its yaw, into cells already known free, and turns in place in steps of 5 deg; every
-  view it holds on the way must track. It starts at the scene's start pose with what that view
-  observes.
+- The vehicle moves between neighbouring cells (0.2 m) clear of every block by the planners' robot
+  radius, keeping its yaw, and turns in place in steps of 5 deg; every view it holds on the way
+  must track. It starts at the scene's start pose.
 
-Three questions, each answered by a search over (cell, yaw) states:
-- `prior`: every free cell is known from the start (a survey map): is there a tracking route?
-- `explore`: only what tracking views have observed is known (online from no map): is there one?
-  The known space grows with every view any reachable state holds, until nothing changes.
-- `any_view`: the same exploration where every view tracks (the VO ignored): the check that the
-  geometry alone lets an explorer through.
-A flight that keeps the VO and never enters space it has not observed exists in this model only if
-`explore` reaches the goal. Where `prior` does and `explore` does not, the unknown space alone
-stands between the planners and the goal.
+Four questions, each a search over (cell, yaw) states:
+- `prior`: every free cell is known (a survey map). Is there a tracking route?
+- `explore`: only what reached views observed is known, and a move goes into known space (online
+  from no map, a map kept). The known space grows with every view any reachable state holds, until
+  nothing changes: a flight that keeps the VO and never enters space it has not observed exists in
+  the model exactly when `explore` reaches the goal (it may have to fly elsewhere to look).
+- `look_ahead`: each move lies within `--look-half-deg` of the yaw held (the trial's look-ahead
+  rule, everywhere, no map kept): the vehicle sees each step from where it is.
+- `any_view`: `explore` with every view tracking: the geometry alone lets an explorer through.
+Where `prior` reaches the goal and `explore` does not, the unknown space alone stands between a
+VO-keeping flight and the goal; where `explore` does and `look_ahead` does not, only a flight that
+looks elsewhere than where it goes, and remembers, gets there.
 
 Usage:
-  /usr/bin/python3 scripts/route_oracle.py SCENE_DIR_OR_GENERATED_JSON... [--out FILE.json] [--figure DIR]
-Exit status 2 with one line naming the file for bad input.
+  /usr/bin/python3 scripts/route_oracle.py SCENE... [--out FILE.json] [--figure DIR]
+  /usr/bin/python3 scripts/route_oracle.py --check-views TRIAL_OR_SWEEP... [--scene-root DIR] [--out FILE.json]
+SCENE: a folder of tgnav scene generate, its generated.json, or a scene file (.yaml) of configs/scenes.
+Exit status 2 with one line naming the file for bad input, nothing written.
 """
 import argparse
 import collections
@@ -43,14 +53,79 @@ class InputError(Exception):
     pass
 
 
+def numbers(file, where, text, count):
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise InputError(f"{file}: {where}: '{text}' is not {count} numbers")
+    return values
+
+
+def load_mjcf_scene(file):
+    """A scene file of configs/scenes (mjcf, flight_height_m, start, goal, bounds) as a layout:
+    the MJCF's box and cylinder geoms (axis-aligned; a rotated one is refused) that reach into the
+    flight height +- 0.3 m (the planners' slice) are the blocks; a geom whose material has a texture
+    from a file is rich, any other (a colour, a builtin checker) plain."""
+    import xml.etree.ElementTree as ET
+    import yaml
+    try:
+        with open(file) as f:
+            doc = yaml.safe_load(f)
+    except (OSError, yaml.YAMLError) as e:
+        raise InputError(f"{file}: cannot read a scene file: {e}")
+    for key in ("mjcf", "flight_height_m", "start", "goal", "bounds"):
+        if not isinstance(doc, dict) or key not in doc:
+            raise InputError(f"{file}: key '{key}' missing (not a scene file of configs/scenes)")
+    mjcf = os.path.join(os.path.dirname(file), doc["mjcf"])
+    try:
+        root = ET.parse(mjcf).getroot()
+    except (OSError, ET.ParseError) as e:
+        raise InputError(f"{file}: mjcf: cannot read '{mjcf}': {e}")
+    textures = {t.get("name"): t for t in root.iter("texture")}
+    textured = set()
+    for m in root.iter("material"):
+        t = textures.get(m.get("texture"))
+        if t is not None and t.get("builtin") in (None, "none"):
+            textured.add(m.get("name"))
+    height = float(doc["flight_height_m"])
+    surfaces = []
+    for g in root.iter("geom"):
+        kind = g.get("type", "sphere")
+        if kind not in ("box", "cylinder"):
+            continue
+        name = g.get("name", f"geom{len(surfaces)}")
+        if any(g.get(a) for a in ("euler", "quat", "axisangle", "zaxis", "xyaxes", "fromto")):
+            raise InputError(f"{mjcf}: geom '{name}': rotated geoms are not supported by the plane model")
+        pos = numbers(mjcf, f"geom '{name}' pos", g.get("pos", "0 0 0"), 3)
+        size = numbers(mjcf, f"geom '{name}' size", g.get("size", ""), 3 if kind == "box" else 2)
+        half_z = size[2] if kind == "box" else size[1]
+        if pos[2] + half_z < height - 0.3 or pos[2] - half_z > height + 0.3:
+            continue
+        surfaces.append({"name": name, "type": kind, "centre_m": pos,
+                         "half_size_m": size[:2] if kind == "box" else [size[0], half_z],
+                         "level": "rich" if g.get("material") in textured else "plain"})
+    lo, hi = doc["bounds"]["min"], doc["bounds"]["max"]
+    return {"room": {"min_m": lo, "max_m": hi}, "surfaces": surfaces, "start": doc["start"], "goal": doc["goal"]}
+
+
 def load_scene(path):
-    """The generated.json of a scene folder (or the file itself)."""
+    """The generated.json of a scene folder (or the file itself), or a scene file of
+    configs/scenes (.yaml) with its MJCF."""
     file = os.path.join(path, "generated.json") if os.path.isdir(path) else path
+    if file.endswith((".yaml", ".yml")):
+        scene = load_mjcf_scene(file)
+        return check_scene(file, scene)
     try:
         with open(file) as f:
             scene = json.load(f)
     except (OSError, ValueError) as e:
         raise InputError(f"{file}: cannot read a generated scene: {e}")
+    return check_scene(file, scene)
+
+
+def check_scene(file, scene):
     for key in ("room", "surfaces", "start", "goal"):
         if key not in scene:
             raise InputError(f"{file}: key '{key}' missing (not a generated.json of tgnav scene generate)")
@@ -63,6 +138,9 @@ def load_scene(path):
         if not (isinstance(scene[key], list) and len(scene[key]) == 4):
             raise InputError(f"{file}: {key}: {scene[key]!r} is not [x, y, z, yaw]")
     scene["_file"] = file
+    base = os.path.basename(file)
+    scene["_name"] = (os.path.basename(os.path.dirname(os.path.abspath(file))) if base == "generated.json"
+                      else os.path.splitext(base)[0])
     return scene
 
 
@@ -153,25 +231,25 @@ def analyse(scene, args):
     fired = np.zeros((len(cells), n_rays), bool)
     samples = np.arange(0.0, args.map_range, step * 0.5)
 
-    def observe(c, k, known, observer):
+    def observe(c, k, known):
         """Marks known the cells a view observes (along its rays to the first block or the map
         range); returns those newly known. Each ray from a cell is walked once."""
-        new = []
         x0, y0 = X[tuple(cells[c])], Y[tuple(cells[c])]
         cols = (k * rays_per_yaw + shifts) % n_rays
         cols = cols[~fired[c, cols]]
+        if not len(cols):
+            return []
         fired[c, cols] = True
-        for col in cols:
-            d = samples[samples < min(dist[c, col], args.map_range)]
-            i = ((x0 + d * math.cos(angles[col]) - lo[0]) // step).astype(int)
-            j = ((y0 + d * math.sin(angles[col]) - lo[1]) // step).astype(int)
-            inside = (i >= 0) & (j >= 0) & (i < nx) & (j < ny)
-            o = index[i[inside], j[inside]]
-            o = o[o >= 0]
-            o = np.unique(o[~known[o]])
-            known[o] = True
-            observer[o] = c * n_yaw + k
-            new.extend(o.tolist())
+        reach = np.minimum(dist[c, cols], args.map_range)
+        d = np.where(samples[None, :] < reach[:, None], samples[None, :], 0.0)  # beyond reach: the cell itself
+        i = ((x0 + d * np.cos(angles[cols])[:, None] - lo[0]) // step).astype(int)
+        j = ((y0 + d * np.sin(angles[cols])[:, None] - lo[1]) // step).astype(int)
+        inside = (i >= 0) & (j >= 0) & (i < nx) & (j < ny)
+        o = index[i[inside], j[inside]]
+        o = o[o >= 0]
+        o = np.unique(o[~known[o]])
+        known[o] = True
+        new = o.tolist()
         return new
 
     def locate(pose, what):
@@ -187,22 +265,30 @@ def analyse(scene, args):
     goal = locate(scene["goal"], "goal")
     start_yaw = int(round((scene["start"][3] % (2 * math.pi)) / math.radians(args.yaw_step_deg))) % n_yaw
     neighbours = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
-    adjacency = []
+    adjacency = []  # per cell: (neighbour, the move's heading in yaw steps, fractional)
     for c in range(len(cells)):
         adj = []
         for di, dj in neighbours:
             i, j = cells[c][0] + di, cells[c][1] + dj
             if 0 <= i < nx and 0 <= j < ny and index[i, j] >= 0:
-                adj.append(index[i, j])
+                adj.append((index[i, j], math.degrees(math.atan2(dj, di)) / args.yaw_step_deg))
         adjacency.append(adj)
 
-    def search(known_all, track_all):
-        ok = np.ones_like(tracks) if track_all else tracks
+    def in_look(heading, k):
+        """Whether a move along `heading` (yaw steps) lies within the look-ahead's half field of
+        view of yaw k."""
+        off = abs((heading - k + n_yaw / 2) % n_yaw - n_yaw / 2) * args.yaw_step_deg
+        return off <= args.look_half_deg + 1e-9
+
+    def search(mode):
+        """prior: all known; explore: known is what reached views observed; look_ahead: a move is
+        into the view's own look-ahead cone (no memory); any_view: explore, every view tracking."""
+        ok = np.ones_like(tracks) if mode == "any_view" else tracks
         if not ok[start, start_yaw]:
             return {"reached": False, "why": "the start view does not track", "known_share": 0.0}
-        known = np.ones(len(cells), bool) if known_all else np.zeros(len(cells), bool)
+        mapping = mode in ("explore", "any_view")
+        known = np.zeros(len(cells), bool) if mapping else np.ones(len(cells), bool)
         fired[:] = False
-        observer = np.full(len(cells), -1)  # the state (c * n_yaw + k) that first observed each cell
         seen = np.zeros_like(tracks)
         waiting = collections.defaultdict(list)
         queue = collections.deque()
@@ -216,14 +302,14 @@ def analyse(scene, args):
             seen[c, k] = True
             parent[state] = prev
             queue.append(state)
-            if not known_all:
+            if mapping:
                 looking.append(state)
 
         known[start] = True
         visit((start, start_yaw), None)
         while queue:
             while looking:
-                for o in observe(*looking.pop(), known, observer):
+                for o in observe(*looking.pop(), known):
                     for w, wprev in waiting.pop(o, []):
                         visit(w, wprev)
             c, k = queue.popleft()
@@ -233,28 +319,25 @@ def analyse(scene, args):
                 while s is not None:
                     path.append(s)
                     s = parent[s]
-                path.reverse()
-                def pose(c, k):
-                    return [float(X[tuple(cells[c])]), float(Y[tuple(cells[c])]), k * args.yaw_step_deg]
-
-                xy = [pose(*p) for p in path]
-                # Where each cell of the path was first observed from ([x, y, yaw_deg]; none: known
-                # from the start, a survey).
-                seen_from = [pose(*divmod(int(observer[p[0]]), n_yaw)) if observer[p[0]] >= 0 else None for p in path]
-                return {"reached": True, "known_share": float(known.mean()), "path": xy, "seen_from": seen_from,
+                xy = [[float(X[tuple(cells[p[0]])]), float(Y[tuple(cells[p[0]])]), p[1] * args.yaw_step_deg]
+                      for p in reversed(path)]
+                return {"reached": True, "known_share": float(known.mean()), "path": xy,
                         "path_length_m": float(sum(math.dist(a[:2], b[:2]) for a, b in zip(xy, xy[1:])))}
             for dk in (-1, 1):
                 visit((c, (k + dk) % n_yaw), (c, k))
-            for n in adjacency[c]:
-                if known[n]:
+            for n, heading in adjacency[c]:
+                if mode == "look_ahead":
+                    if in_look(heading, k):
+                        visit((n, k), (c, k))
+                elif known[n]:
                     visit((n, k), (c, k))
                 elif ok[n, k]:
                     waiting[n].append(((n, k), (c, k)))
         return {"reached": False, "why": "no tracking state reaches the goal", "known_share": float(known.mean())}
 
-    result = {"scene": scene["_file"], "cells": int(len(cells)),
-              "tracking_share": float(tracks.mean()),
-              "prior": search(True, False), "explore": search(False, False), "any_view": search(False, True)}
+    result = {"scene": scene["_file"], "cells": int(len(cells)), "tracking_share": float(tracks.mean())}
+    for mode in ("prior", "explore", "look_ahead", "any_view"):
+        result[mode] = search(mode)
     result["_draw"] = (X, Y, free, cells, tracks)
     return result
 
@@ -277,31 +360,131 @@ def figure(result, scene, out_dir):
             ax.add_patch(plt.Rectangle((cx - hx, cy - hy), 2 * hx, 2 * hy, color=colour))
         else:
             ax.add_patch(plt.Circle((cx, cy), s["half_size_m"][0], color=colour))
-    for key, style in (("prior", "w--"), ("explore", "m-")):
+    for key, style in (("prior", "w--"), ("explore", "m-"), ("look_ahead", "c:")):
         if result[key]["reached"]:
             p = np.array(result[key]["path"])
             ax.plot(p[:, 0], p[:, 1], style, lw=2, label=f"{key}: {result[key]['path_length_m']:.1f} m")
-    if result["explore"]["reached"]:
-        views = np.array(sorted({tuple(v) for v in result["explore"]["seen_from"] if v is not None}))
-        if len(views):
-            yaw = np.radians(views[:, 2])
-            ax.quiver(views[:, 0], views[:, 1], np.cos(yaw), np.sin(yaw), color="orange", scale=25, width=0.004,
-                      label="views that observed the explore route")
     ax.plot(*scene["start"][:2], "wo", ms=9, mec="k", label="start")
     ax.plot(*scene["goal"][:2], "y*", ms=14, mec="k", label="goal")
     ax.set_aspect("equal")
-    ax.set_title(f"{os.path.basename(os.path.dirname(scene['_file']))}: prior {'yes' if result['prior']['reached'] else 'no'}, "
-                 f"explore {'yes' if result['explore']['reached'] else 'no'} (red: rich/medium blocks)")
-    ax.legend(loc="lower left", fontsize=8)
+    ax.set_title(f"{scene['_name']}: prior {'yes' if result['prior']['reached'] else 'no'}, "
+                 f"explore {'yes' if result['explore']['reached'] else 'no'}, "
+                 f"look_ahead {'yes' if result['look_ahead']['reached'] else 'no'} (red: rich/medium blocks)")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06), ncol=3, fontsize=8)
     os.makedirs(out_dir, exist_ok=True)
-    name = os.path.basename(os.path.dirname(os.path.abspath(scene["_file"]))) or "scene"
-    fig.savefig(os.path.join(out_dir, f"{name}_oracle.png"), dpi=110, bbox_inches="tight")
+    fig.savefig(os.path.join(out_dir, f"{scene['_name']}_oracle.png"), dpi=110, bbox_inches="tight")
     plt.close(fig)
+
+
+# --- --check-views: the view rule against the VO's frames of flown trials -----------------------
+
+def view_shares(plane, x, y, yaw, args):
+    """The share of each view's rays (61 across the field of view) that end on a textured block
+    within the VO's depth range, for views at (x, y) looking along yaw (arrays)."""
+    half = math.radians(args.hfov_deg) / 2
+    angles = yaw[:, None] + np.linspace(-half, half, 61)[None, :]
+    steps = np.arange(1, int(math.ceil(args.vo_range / (0.5 * plane.fine))) + 1) * 0.5 * plane.fine
+    px = x[:, None, None] + steps[None, None, :] * np.cos(angles)[:, :, None]
+    py = y[:, None, None] + steps[None, None, :] * np.sin(angles)[:, :, None]
+    ix, iy = plane.cell(px, py)
+    ok = (ix >= 0) & (iy >= 0) & (ix < plane.shape[0]) & (iy < plane.shape[1])
+    lab = np.where(ok, plane.label[np.clip(ix, 0, plane.shape[0] - 1), np.clip(iy, 0, plane.shape[1] - 1)], -1)
+    hit = lab >= 0
+    first = np.where(hit.any(axis=2), hit.argmax(axis=2), 0)
+    has = hit.any(axis=2)
+    d = steps[first]
+    block = np.take_along_axis(lab, first[:, :, None], axis=2)[:, :, 0]
+    good = has & plane.textured[block] & (d >= args.min_range) & (d <= args.vo_range)
+    return good.mean(axis=1)
+
+
+def trial_folders(path):
+    """A trial folder (vo.csv, gt.tum, config.yaml), or every trial of a sweep folder (index.csv)."""
+    index = os.path.join(path, "index.csv")
+    if os.path.isfile(index):
+        import csv
+        with open(index) as f:
+            rows = list(csv.DictReader(f))
+        if rows and "folder" not in rows[0]:
+            raise InputError(f"{index}: column 'folder' missing (not a sweep's index.csv)")
+        return [os.path.join(path, r["folder"]) for r in rows]
+    if not os.path.isfile(os.path.join(path, "vo.csv")):
+        raise InputError(f"{path}: neither a trial folder (vo.csv) nor a sweep folder (index.csv)")
+    return [path]
+
+
+def trial_scene(folder, scene_root):
+    """The scene a trial flew: its config.yaml's scene (a generated scene's generated.json two
+    folders up), or, where that file is gone, the file of that name in scene_root."""
+    import yaml
+    file = os.path.join(folder, "config.yaml")
+    try:
+        with open(file) as f:
+            scene = (yaml.safe_load(f) or {}).get("scene")
+    except (OSError, yaml.YAMLError) as e:
+        raise InputError(f"{file}: cannot read: {e}")
+    if not isinstance(scene, str):
+        raise InputError(f"{file}: key 'scene' missing")
+    if not os.path.exists(scene) and scene_root:
+        scene = os.path.join(scene_root, os.path.basename(scene))
+    generated = os.path.join(os.path.dirname(os.path.dirname(scene)), "generated.json")
+    if os.path.isfile(generated):
+        return load_scene(generated)
+    if not os.path.isfile(scene):
+        raise InputError(f"{file}: scene: '{scene}' does not exist (--scene-root names a folder of scene files)")
+    return load_scene(scene)
+
+
+def check_views(paths, args):
+    """Per VO frame of the trials (the first, the VO's start, left out): the view rule's share at
+    the true camera pose, the inliers and whether the frame was lost."""
+    share, inliers, lost = [], [], []
+    for path in paths:
+        for folder in trial_folders(path):
+            scene = trial_scene(folder, args.scene_root)
+            plane = Plane(scene, args.fine)
+            import csv
+            try:
+                gt = np.loadtxt(os.path.join(folder, "gt.tum"), ndmin=2)
+                with open(os.path.join(folder, "vo.csv")) as f:
+                    frames = list(csv.DictReader(f))
+            except (OSError, ValueError) as e:
+                raise InputError(f"{folder}: cannot read gt.tum or vo.csv: {e}")
+            if gt.shape[1] != 8 or not frames:
+                raise InputError(f"{folder}/gt.tum: not 8 columns (TUM), or vo.csv has no frame")
+            t = np.array([float(r["t"]) for r in frames[1:]])
+            rows = np.clip(np.searchsorted(gt[:, 0], t - 1e-6), 0, len(gt) - 1)
+            qx, qy, qz, qw = gt[rows, 4], gt[rows, 5], gt[rows, 6], gt[rows, 7]
+            yaw = np.arctan2(2 * (qy * qz - qw * qx), 2 * (qx * qz + qw * qy))  # the optical axis (camera z)
+            for a in range(0, len(t), 256):
+                share.extend(view_shares(plane, gt[rows[a:a + 256], 1], gt[rows[a:a + 256], 2], yaw[a:a + 256], args))
+            inliers.extend(int(r["inliers"] or 0) for r in frames[1:])
+            lost.extend(r["status"] == "lost" for r in frames[1:])
+    share, inliers, lost = np.array(share), np.array(inliers), np.array(lost)
+    bins = [0.0, 0.1, 0.2, args.share, 0.5, 1.0 + 1e-9]
+    table = []
+    for a, b in zip(bins, bins[1:]):
+        k = (share >= a) & (share < b)
+        table.append({"share_from": a, "share_to": min(b, 1.0), "frames": int(k.sum()),
+                      "lost": int((lost & k).sum()),
+                      "inliers_median": float(np.median(inliers[k])) if k.any() else None,
+                      "below_30_inliers": float(np.mean(inliers[k] < 30)) if k.any() else None})
+        print(f"share [{a:.2f}, {min(b, 1.0):.2f}): {k.sum():6d} frames, lost {int((lost & k).sum()):3d}, "
+              + (f"inliers median {np.median(inliers[k]):4.0f}, < 30 in {np.mean(inliers[k] < 30):.3f}" if k.any() else ""))
+    tracks = share >= args.share
+    print(f"views the rule says track (share >= {args.share:.3f}): {int(tracks.sum())} frames, {int((lost & tracks).sum())} lost; "
+          f"the others: {int((~tracks).sum())} frames, {int((lost & ~tracks).sum())} lost")
+    return {"frames": int(len(share)), "lost": int(lost.sum()), "bins": table,
+            "rule_tracks": {"frames": int(tracks.sum()), "lost": int((lost & tracks).sum())}}
 
 
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("scenes", nargs="+", help="scene folders of tgnav scene generate, or their generated.json")
+    ap.add_argument("scenes", nargs="+", help="scene folders of tgnav scene generate, their generated.json, or scene "
+                    "files of configs/scenes; with --check-views, trial or sweep folders")
+    ap.add_argument("--check-views", action="store_true",
+                    help="instead: the view rule against the VO's frames of flown trials (trial or sweep folders)")
+    ap.add_argument("--scene-root", help="with --check-views: a folder of scene files, for trials whose scene moved")
     ap.add_argument("--out", help="write the results as JSON here")
     ap.add_argument("--figure", help="write one figure per scene into this folder")
     ap.add_argument("--cell", type=float, default=0.2, help="the search's cell, m (0.2)")
@@ -313,14 +496,21 @@ def main(argv):
     ap.add_argument("--map-range", type=float, default=6.0, help="the online mapper's range, m (6)")
     ap.add_argument("--hfov-deg", type=float, default=75.0, help="the camera's horizontal field of view (75)")
     ap.add_argument("--yaw-step-deg", type=float, default=5.0, help="the yaws searched (5)")
+    ap.add_argument("--look-half-deg", type=float, default=27.6,
+                    help="look_ahead: the half cone a move must lie in (27.6: the trial's look-ahead, "
+                         "planner::lookAheadHalfFov at the defaults)")
     args = ap.parse_args(argv)
-    for name in ("cell", "fine", "share", "vo_range", "map_range", "hfov_deg", "yaw_step_deg"):
+    for name in ("cell", "fine", "share", "vo_range", "map_range", "hfov_deg", "yaw_step_deg", "look_half_deg"):
         v = getattr(args, name)
         if not (v > 0 and math.isfinite(v)):
             raise InputError(f"--{name.replace('_', '-')}: {v} must be a positive number")
     if not (0 < args.share <= 1) or args.radius < 0 or 360 % args.yaw_step_deg:
         raise InputError(f"--share {args.share} must lie in (0, 1], --radius {args.radius} >= 0, "
                          f"--yaw-step-deg {args.yaw_step_deg} must divide 360")
+    if args.check_views:
+        report = check_views(args.scenes, args)
+        write_json(args.out, {"settings": vars(args), "check_views": report})
+        return 0
     results = []
     for path in args.scenes:
         scene = load_scene(path)
@@ -329,17 +519,22 @@ def main(argv):
             figure(r, scene, args.figure)
         del r["_draw"]
         results.append(r)
-        print(f"{scene['_file']}: prior {'yes' if r['prior']['reached'] else 'no'}, "
-              f"explore {'yes' if r['explore']['reached'] else 'no'} (known {r['explore']['known_share']:.2f}), "
-              f"any_view {'yes' if r['any_view']['reached'] else 'no'}, views that track {r['tracking_share']:.2f}")
-    print(f"explore reaches the goal in {sum(r['explore']['reached'] for r in results)}/{len(results)}, "
-          f"prior in {sum(r['prior']['reached'] for r in results)}/{len(results)}")
-    if args.out:
-        tmp = args.out + ".tmp"
-        with open(tmp, "w") as f:
-            json.dump({"settings": vars(args), "scenes": results}, f, indent=1)
-        os.replace(tmp, args.out)
+        print(f"{scene['_file']}: " + ", ".join(f"{m} " + (f"{r[m]['path_length_m']:.1f} m" if r[m]["reached"] else "no")
+                                                  for m in ("prior", "explore", "look_ahead", "any_view"))
+              + f" (views that track {r['tracking_share']:.2f}, explore knew {r['explore']['known_share']:.2f})")
+    print("reach the goal: " + ", ".join(f"{m} {sum(r[m]['reached'] for r in results)}/{len(results)}"
+                                         for m in ("prior", "explore", "look_ahead", "any_view")))
+    write_json(args.out, {"settings": vars(args), "scenes": results})
     return 0
+
+
+def write_json(path, doc):
+    """Whole or not at all."""
+    if path:
+        tmp = path + ".tmp"
+        with open(tmp, "w") as f:
+            json.dump(doc, f, indent=1)
+        os.replace(tmp, path)
 
 
 if __name__ == "__main__":

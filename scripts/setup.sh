@@ -43,7 +43,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-matplotlib                  # every figure (scripts/tgnav_plots.py)
   python3-numpy                       # the example external planners (scripts/planners/)
-  python3-sklearn python3-scipy       # the learned perception model (scripts/fit_track_model.py)
+  python3-sklearn python3-scipy       # the learned perception model (scripts/fit_track_model.py), route_oracle.py
+  python3-yaml                        # scene and trial files in scripts/route_oracle.py
   clang-format-14                     # the style check (scripts/check_format.sh, CTest format.check)
   clang-14 libclang-rt-14-dev clang-tidy-14  # sanitizers, libFuzzer, clang-tidy (scripts/sanitize.sh, tidy.sh)
   slurmctld slurmd slurm-client munge # the Slurm sweep backend's test (a private single-node cluster)

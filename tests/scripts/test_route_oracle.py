@@ -1,8 +1,10 @@
 """scripts/route_oracle.py on synthetic generated scenes: a corridor textured only behind the start
 is flyable looking back with a map (prior) but not explorable (every view that would observe the
 way ahead is bare); texture along its side makes it explorable; with every view tracking the
-geometry alone lets the explorer through. Bad input: one line naming the file and key, exit 2,
-nothing written.
+geometry alone lets the explorer through. The same corridor as an MJCF scene file gives the same
+answers (a material with a file texture is textured; geoms outside the flight band are left out).
+--check-views counts a trial's VO frames by the rule's share at the true pose. Bad input: one
+line naming the file and key, exit 2, nothing written.
 
 Run: TGNAV_SCRIPTS_DIR=scripts /usr/bin/python3 -m unittest -v test_route_oracle (in tests/scripts).
 """
@@ -36,6 +38,27 @@ def corridor(north_level="plain", start=(1.0, 2.0, math.pi), goal=(7.0, 2.0, mat
     return {"kind": "test", "room": {"min_m": [0, 0, 0], "max_m": [LENGTH, WIDTH, 3], "size_m": [LENGTH, WIDTH, 3]},
             "surfaces": surfaces, "start": [start[0], start[1], 1.0, start[2]],
             "goal": [goal[0], goal[1], 1.0, goal[2]]}
+
+
+MJCF = """<mujoco>
+  <asset>
+    <texture name="art" type="2d" file="art.png"/>
+    <texture name="floor" type="2d" builtin="checker" rgb1="0.5 0.5 0.5" rgb2="0.52 0.52 0.52" width="8" height="8"/>
+    <material name="art" texture="art"/>
+    <material name="floor" texture="floor"/>
+    <material name="wall" rgba="0.8 0.8 0.8 1"/>
+  </asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="6 2 0.05" material="floor"/>
+    <geom name="wall_w" type="box" pos="-0.05 2 1.5" size="0.05 2.1 1.5" material="art"/>
+    <geom name="wall_e" type="box" pos="12.05 2 1.5" size="0.05 2.1 1.5" material="wall"/>
+    <geom name="wall_s" type="box" pos="6 -0.05 1.5" size="6.1 0.05 1.5" material="wall"/>
+    <geom name="wall_n" type="box" pos="6 4.05 1.5" size="6.1 0.05 1.5" material="wall"/>
+    <geom name="high_art" type="box" pos="6 3.9 2.7" size="6 0.05 0.2" material="art"/>
+    %s
+  </worldbody>
+</mujoco>
+"""
 
 
 class RouteOracleTest(unittest.TestCase):
@@ -79,6 +102,7 @@ class RouteOracleTest(unittest.TestCase):
         self.assertTrue(all(90 <= p[2] <= 270 for p in r["prior"]["path"]))
         self.assertFalse(r["explore"]["reached"])
         self.assertLess(r["explore"]["known_share"], 0.5)
+        self.assertFalse(r["look_ahead"]["reached"])
         self.assertTrue(r["any_view"]["reached"])
 
     def test_texture_along_the_side_makes_it_explorable(self):
@@ -86,15 +110,86 @@ class RouteOracleTest(unittest.TestCase):
         r = self.oracle(scene)
         self.assertTrue(r["explore"]["reached"])
         self.assertRoute(r["explore"], scene)
-        # Every cell of the route but the start's was observed first from some view.
-        self.assertIsNone(r["explore"]["seen_from"][0])
-        self.assertTrue(all(v is not None for v in r["explore"]["seen_from"][1:]))
+        # Looking at the north wall the vehicle can also look where it goes east (yaws within
+        # 27.6 deg of its moves).
+        self.assertTrue(r["look_ahead"]["reached"])
+        self.assertRoute(r["look_ahead"], scene)
+        for a, b in zip(r["look_ahead"]["path"], r["look_ahead"]["path"][1:]):
+            if a[:2] != b[:2]:
+                heading = math.degrees(math.atan2(b[1] - a[1], b[0] - a[0]))
+                self.assertLessEqual(abs((heading - a[2] + 180) % 360 - 180), 27.6 + 1e-6)
 
     def test_a_start_view_that_does_not_track_reaches_nothing(self):
         r = self.oracle(corridor(start=(1.0, 2.0, 0.0)))  # facing the plain east wall 11 m away
         self.assertFalse(r["prior"]["reached"])
         self.assertIn("start view", r["explore"]["why"])
         self.assertTrue(r["any_view"]["reached"])
+
+    def write_mjcf(self, name, extra=""):
+        folder = os.path.join(self.dir.name, name)
+        os.makedirs(folder)
+        with open(os.path.join(folder, "corridor.xml"), "w") as f:
+            f.write(MJCF % extra)
+        scene = os.path.join(folder, "corridor.yaml")
+        with open(scene, "w") as f:
+            f.write("mjcf: corridor.xml\nflight_height_m: 1.0\nstart: [1.0, 2.0, 1.0, 3.1416]\n"
+                    "goal: [7.0, 2.0, 1.0, 3.1416]\nbounds:\n  min: [0, 0, 0]\n  max: [12, 4, 3]\n")
+        return scene
+
+    def test_an_mjcf_scene_file_reads_as_the_same_corridor(self):
+        out = os.path.join(self.dir.name, "out.json")
+        r = self.run_oracle(self.write_mjcf("m"), "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(out) as f:
+            got = json.load(f)["scenes"][0]
+        # The art 2.5 m up on the north wall is outside the flight band: still not explorable.
+        self.assertTrue(got["prior"]["reached"])
+        self.assertFalse(got["explore"]["reached"])
+        self.assertEqual(got["prior"]["path"], self.oracle(corridor())["prior"]["path"])
+        r = self.run_oracle(self.write_mjcf("rot", '<geom name="tilted" type="box" pos="5 2 1" size="0.2 0.2 1" euler="0 0 30"/>'))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("geom 'tilted': rotated", r.stderr)
+
+    def write_trial(self, scene_folder):
+        """A trial in the corridor: 40 frames looking back west at the art (tracked), then 10
+        looking east at the plain wall (lost)."""
+        trial = os.path.join(self.dir.name, "trial")
+        os.makedirs(trial)
+        os.makedirs(os.path.join(scene_folder, "scenes"))
+        with open(os.path.join(trial, "config.yaml"), "w") as f:
+            f.write(f"scene: {os.path.join(scene_folder, 'scenes', 'corridor.yaml')}\n")
+        gt, vo = ["# timestamp tx ty tz qx qy qz qw"], ["t,status,inliers"]
+        for i in range(50):
+            yaw = math.pi if i < 40 else 0.0
+            # The camera's axes in the world (x right, y down, z forward, level) are R's columns.
+            c, s_ = math.cos(yaw), math.sin(yaw)
+            m = [[s_, 0.0, c], [-c, 0.0, s_], [0.0, -1.0, 0.0]]
+            w = math.sqrt(1 + m[0][0] + m[1][1] + m[2][2]) / 2
+            qx, qy, qz = (m[2][1] - m[1][2]) / (4 * w), (m[0][2] - m[2][0]) / (4 * w), (m[1][0] - m[0][1]) / (4 * w)
+            gt.append(f"{i * 0.05:.2f} 2.0 2.0 1.0 {qx} {qy} {qz} {w}")
+            vo.append(f"{i * 0.05:.2f},{'ok' if i < 40 else 'lost'},{500 if i < 40 else 0}")
+        for name, rows in (("gt.tum", gt), ("vo.csv", vo)):
+            with open(os.path.join(trial, name), "w") as f:
+                f.write("\n".join(rows) + "\n")
+        return trial
+
+    def test_check_views_counts_the_frames_by_the_rule(self):
+        scene_folder = os.path.join(self.dir.name, "scene")
+        self.write("scene", corridor())
+        trial = self.write_trial(scene_folder)
+        out = os.path.join(self.dir.name, "check.json")
+        r = self.run_oracle("--check-views", trial, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(out) as f:
+            got = json.load(f)["check_views"]
+        self.assertEqual(got["frames"], 49)  # the VO's first frame left out
+        self.assertEqual(got["lost"], 10)
+        self.assertEqual(got["rule_tracks"], {"frames": 39, "lost": 0})
+        self.assertEqual(sum(b["frames"] for b in got["bins"]), 49)
+        os.remove(os.path.join(trial, "config.yaml"))
+        r = self.run_oracle("--check-views", trial)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("config.yaml: cannot read", r.stderr)
 
     def test_bad_input_is_one_line_and_exit_2(self):
         out = os.path.join(self.dir.name, "bad.json")
