@@ -333,11 +333,15 @@ def analyse(scene, args):
                     visit((n, k), (c, k))
                 elif ok[n, k]:
                     waiting[n].append(((n, k), (c, k)))
-        return {"reached": False, "why": "no tracking state reaches the goal", "known_share": float(known.mean())}
+        # Where it got: the free cells some tracking state reached (all of them: the search ran out).
+        return {"reached": False, "why": "no tracking state reaches the goal", "known_share": float(known.mean()),
+                "_reached": seen.any(axis=1)}
 
     result = {"scene": scene["_file"], "cells": int(len(cells)), "tracking_share": float(tracks.mean())}
     for mode in ("prior", "explore", "look_ahead", "any_view"):
         result[mode] = search(mode)
+        if "_reached" in result[mode]:
+            result[mode]["reached_share"] = float(result[mode]["_reached"].mean())
     result["_draw"] = (X, Y, free, cells, tracks)
     return result
 
@@ -364,12 +368,17 @@ def figure(result, scene, out_dir):
         if result[key]["reached"]:
             p = np.array(result[key]["path"])
             ax.plot(p[:, 0], p[:, 1], style, lw=2, label=f"{key}: {result[key]['path_length_m']:.1f} m")
+    if "_reached" in result["look_ahead"]:
+        reach = np.zeros(free.shape)
+        reach[free] = result["look_ahead"]["_reached"]
+        ax.contour(X, Y, reach, levels=[0.5], colors="cyan", linewidths=1.5)
+        ax.plot([], [], "c-", label="look_ahead: where it got")
     ax.plot(*scene["start"][:2], "wo", ms=9, mec="k", label="start")
     ax.plot(*scene["goal"][:2], "y*", ms=14, mec="k", label="goal")
     ax.set_aspect("equal")
     ax.set_title(f"{scene['_name']}: prior {'yes' if result['prior']['reached'] else 'no'}, "
                  f"explore {'yes' if result['explore']['reached'] else 'no'}, "
-                 f"look_ahead {'yes' if result['look_ahead']['reached'] else 'no'} (red: rich/medium blocks)")
+                 f"look_ahead {'yes' if result['look_ahead']['reached'] else 'no'} (red: textured)")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.06), ncol=3, fontsize=8)
     os.makedirs(out_dir, exist_ok=True)
     fig.savefig(os.path.join(out_dir, f"{scene['_name']}_oracle.png"), dpi=110, bbox_inches="tight")
@@ -518,6 +527,8 @@ def main(argv):
         if args.figure:
             figure(r, scene, args.figure)
         del r["_draw"]
+        for mode in ("prior", "explore", "look_ahead", "any_view"):
+            r[mode].pop("_reached", None)
         results.append(r)
         print(f"{scene['_file']}: " + ", ".join(f"{m} " + (f"{r[m]['path_length_m']:.1f} m" if r[m]["reached"] else "no")
                                                   for m in ("prior", "explore", "look_ahead", "any_view"))
