@@ -496,6 +496,7 @@ def main(argv):
     ap.add_argument("--scene-root", help="with --check-views: a folder of scene files, for trials whose scene moved")
     ap.add_argument("--out", help="write the results as JSON here")
     ap.add_argument("--figure", help="write one figure per scene into this folder")
+    ap.add_argument("--paths", help="write each route found as a path CSV for tgnav trial --path into this folder")
     ap.add_argument("--cell", type=float, default=0.2, help="the search's cell, m (0.2)")
     ap.add_argument("--fine", type=float, default=0.05, help="the layout's raster, m (0.05)")
     ap.add_argument("--radius", type=float, default=0.38, help="clearance, m (the planners' robot radius, 0.38)")
@@ -526,6 +527,8 @@ def main(argv):
         r = analyse(scene, args)
         if args.figure:
             figure(r, scene, args.figure)
+        if args.paths:
+            write_paths(r, scene, args.paths, scene.get("flight_height_m", scene["start"][2]))
         del r["_draw"]
         for mode in ("prior", "explore", "look_ahead", "any_view"):
             r[mode].pop("_reached", None)
@@ -537,6 +540,28 @@ def main(argv):
                                          for m in ("prior", "explore", "look_ahead", "any_view")))
     write_json(args.out, {"settings": vars(args), "scenes": results})
     return 0
+
+
+def write_paths(result, scene, out_dir, height):
+    """Each route found (prior, explore) as a 4-DoF path CSV for `tgnav trial --path` (x,y,z,yaw):
+    the scene's start, one point per cell with the last yaw held there (unwrapped, so the
+    trajectory turns the way the search did), and the goal's position."""
+    os.makedirs(out_dir, exist_ok=True)
+    for mode in ("prior", "explore"):
+        if not result[mode]["reached"]:
+            continue
+        points = []
+        for x, y, yaw in result[mode]["path"]:
+            if points and math.dist(points[-1][:2], (x, y)) < 1e-9:
+                points[-1][2] = yaw
+            else:
+                points.append([x, y, yaw])
+        yaws = np.unwrap([scene["start"][3]] + [math.radians(p[2]) for p in points])  # [i + 1]: points[i]
+        rows = [(scene["start"][0], scene["start"][1], yaws[0])]
+        rows += [(p[0], p[1], yaws[i + 1]) for i, p in enumerate(points[1:-1], start=1)]
+        rows.append((scene["goal"][0], scene["goal"][1], yaws[-1]))
+        with open(os.path.join(out_dir, f"{scene['_name']}_{mode}.csv"), "w") as f:
+            f.write("x,y,z,yaw\n" + "".join(f"{x:.3f},{y:.3f},{height:.3f},{yaw:.4f}\n" for x, y, yaw in rows))
 
 
 def write_json(path, doc):

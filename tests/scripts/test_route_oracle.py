@@ -119,6 +119,21 @@ class RouteOracleTest(unittest.TestCase):
                 heading = math.degrees(math.atan2(b[1] - a[1], b[0] - a[0]))
                 self.assertLessEqual(abs((heading - a[2] + 180) % 360 - 180), 27.6 + 1e-6)
 
+    def test_routes_are_written_as_paths_tgnav_trial_flies(self):
+        scene = corridor(north_level="medium")
+        paths = os.path.join(self.dir.name, "paths")
+        self.oracle(scene, "--paths", paths)
+        self.assertEqual(sorted(os.listdir(paths)), ["scene_explore.csv", "scene_prior.csv"])
+        with open(os.path.join(paths, "scene_explore.csv")) as f:
+            lines = f.read().split()
+        self.assertEqual(lines[0], "x,y,z,yaw")
+        rows = [[float(v) for v in line.split(",")] for line in lines[1:]]
+        self.assertEqual(rows[0], [1.0, 2.0, 1.0, round(math.pi, 4)])  # the start, its yaw
+        self.assertEqual(rows[-1][:3], [7.0, 2.0, 1.0])                 # the goal
+        for a, b in zip(rows, rows[1:]):
+            self.assertLess(math.dist(a[:2], b[:2]), 0.5)  # neighbouring cells; the start and goal within a cell of theirs
+            self.assertLessEqual(abs(b[3] - a[3]), math.pi)  # unwrapped: no jump of a turn
+
     def test_a_start_view_that_does_not_track_reaches_nothing(self):
         r = self.oracle(corridor(start=(1.0, 2.0, 0.0)))  # facing the plain east wall 11 m away
         self.assertFalse(r["prior"]["reached"])
