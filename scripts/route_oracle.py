@@ -9,9 +9,9 @@ The model:
   slice). A generated block is textured when rich or medium; a geom when its material has a texture
   from a file (colours and builtin checkers are plain).
 - A view (a cell, a yaw) *tracks* when at least `--share` of its rays across the camera's field of
-  view (75 deg) end, within the VO's depth range, on a textured block. A third is the rule the
-  detour generator builds its premise with (harness/scenes/layout_detour.cpp). `--check-views`
-  measures the rule against the VO's frames of flown trials.
+  view (75 deg) end, within `--track-range`, on a textured block. A third within 7 m is the rule
+  the detour generator builds its premise with (harness/scenes/layout_detour.cpp: the long route's
+  views). `--check-views` measures the rule against the VO's frames of flown trials.
 - A view *observes* the cells along its rays up to the first block or the mapper's range
   (`trial.map_range_m`, 6 m): they become known free.
 - The vehicle moves between neighbouring cells (0.2 m) clear of every block by the planners' robot
@@ -216,11 +216,11 @@ def analyse(scene, args):
     rays_per_yaw = 4  # rays every yaw_step/4 all round
     n_rays = n_yaw * rays_per_yaw
     angles = np.arange(n_rays) * 2 * math.pi / n_rays
-    dist, tex = plane.march(X[free], Y[free], angles, max(args.vo_range, args.map_range))
+    dist, tex = plane.march(X[free], Y[free], angles, max(args.track_range, args.map_range))
     half = math.radians(args.hfov_deg) / 2
     half_rays = int(round(half / (2 * math.pi / n_rays)))
     view_rays = 2 * half_rays + 1
-    good = tex & (dist <= args.vo_range) & (dist >= args.min_range)
+    good = tex & (dist <= args.track_range) & (dist >= args.min_range)
     # tracks[c, k]: the view at yaw k*yaw_step from cell c sees enough texture.
     shifts = np.arange(-half_rays, half_rays + 1)
     tracks = np.zeros((len(cells), n_yaw), bool)
@@ -389,10 +389,10 @@ def figure(result, scene, out_dir):
 
 def view_shares(plane, x, y, yaw, args):
     """The share of each view's rays (61 across the field of view) that end on a textured block
-    within the VO's depth range, for views at (x, y) looking along yaw (arrays)."""
+    within the track range, for views at (x, y) looking along yaw (arrays)."""
     half = math.radians(args.hfov_deg) / 2
     angles = yaw[:, None] + np.linspace(-half, half, 61)[None, :]
-    steps = np.arange(1, int(math.ceil(args.vo_range / (0.5 * plane.fine))) + 1) * 0.5 * plane.fine
+    steps = np.arange(1, int(math.ceil(args.track_range / (0.5 * plane.fine))) + 1) * 0.5 * plane.fine
     px = x[:, None, None] + steps[None, None, :] * np.cos(angles)[:, :, None]
     py = y[:, None, None] + steps[None, None, :] * np.sin(angles)[:, :, None]
     ix, iy = plane.cell(px, py)
@@ -403,7 +403,7 @@ def view_shares(plane, x, y, yaw, args):
     has = hit.any(axis=2)
     d = steps[first]
     block = np.take_along_axis(lab, first[:, :, None], axis=2)[:, :, 0]
-    good = has & plane.textured[block] & (d >= args.min_range) & (d <= args.vo_range)
+    good = has & plane.textured[block] & (d >= args.min_range) & (d <= args.track_range)
     return good.mean(axis=1)
 
 
@@ -501,7 +501,9 @@ def main(argv):
     ap.add_argument("--fine", type=float, default=0.05, help="the layout's raster, m (0.05)")
     ap.add_argument("--radius", type=float, default=0.38, help="clearance, m (the planners' robot radius, 0.38)")
     ap.add_argument("--share", type=float, default=1 / 3, help="share of a view's rays on texture that tracks (1/3)")
-    ap.add_argument("--vo-range", type=float, default=10.0, help="the VO's depth range, m (10)")
+    ap.add_argument("--track-range", type=float, default=7.0,
+                    help="texture farther than this does not count toward a view's share, m (7: the detour "
+                         "generator's kRouteViewRangeM; the VO's depth reaches 10)")
     ap.add_argument("--min-range", type=float, default=0.3, help="the camera's nearest depth, m (0.3)")
     ap.add_argument("--map-range", type=float, default=6.0, help="the online mapper's range, m (6)")
     ap.add_argument("--hfov-deg", type=float, default=75.0, help="the camera's horizontal field of view (75)")
@@ -510,7 +512,7 @@ def main(argv):
                     help="look_ahead: the half cone a move must lie in (27.6: the trial's look-ahead, "
                          "planner::lookAheadHalfFov at the defaults)")
     args = ap.parse_args(argv)
-    for name in ("cell", "fine", "share", "vo_range", "map_range", "hfov_deg", "yaw_step_deg", "look_half_deg"):
+    for name in ("cell", "fine", "share", "track_range", "map_range", "hfov_deg", "yaw_step_deg", "look_half_deg"):
         v = getattr(args, name)
         if not (v > 0 and math.isfinite(v)):
             raise InputError(f"--{name.replace('_', '-')}: {v} must be a positive number")

@@ -28,7 +28,7 @@ def box(name, cx, cy, hx, hy, level):
             "obstacle": None, "textures": {}}
 
 
-def corridor(north_level="plain", start=(1.0, 2.0, math.pi), goal=(7.0, 2.0, math.pi)):
+def corridor(north_level="plain", start=(1.0, 2.0, math.pi), goal=(5.0, 2.0, math.pi)):
     """A 12 m x 4 m corridor: its west wall (behind the start, which faces it) rich, the east and
     south walls plain, the north wall `north_level`."""
     surfaces = [box("wall_w", -0.05, WIDTH / 2, 0.05, WIDTH / 2 + 0.1, "rich"),
@@ -129,7 +129,7 @@ class RouteOracleTest(unittest.TestCase):
         self.assertEqual(lines[0], "x,y,z,yaw")
         rows = [[float(v) for v in line.split(",")] for line in lines[1:]]
         self.assertEqual(rows[0], [1.0, 2.0, 1.0, round(math.pi, 4)])  # the start, its yaw
-        self.assertEqual(rows[-1][:3], [7.0, 2.0, 1.0])                 # the goal
+        self.assertEqual(rows[-1][:3], [5.0, 2.0, 1.0])                 # the goal
         for a, b in zip(rows, rows[1:]):
             self.assertLess(math.dist(a[:2], b[:2]), 0.5)  # neighbouring cells; the start and goal within a cell of theirs
             self.assertLessEqual(abs(b[3] - a[3]), math.pi)  # unwrapped: no jump of a turn
@@ -148,7 +148,7 @@ class RouteOracleTest(unittest.TestCase):
         scene = os.path.join(folder, "corridor.yaml")
         with open(scene, "w") as f:
             f.write("mjcf: corridor.xml\nflight_height_m: 1.0\nstart: [1.0, 2.0, 1.0, 3.1416]\n"
-                    "goal: [7.0, 2.0, 1.0, 3.1416]\nbounds:\n  min: [0, 0, 0]\n  max: [12, 4, 3]\n")
+                    "goal: [5.0, 2.0, 1.0, 3.1416]\nbounds:\n  min: [0, 0, 0]\n  max: [12, 4, 3]\n")
         return scene
 
     def test_an_mjcf_scene_file_reads_as_the_same_corridor(self):
