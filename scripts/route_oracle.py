@@ -89,7 +89,12 @@ def load_mjcf_scene(file):
         t = textures.get(m.get("texture"))
         if t is not None and t.get("builtin") in (None, "none"):
             textured.add(m.get("name"))
-    height = float(doc["flight_height_m"])
+    height = doc["flight_height_m"]
+    if not (isinstance(height, (int, float)) and not isinstance(height, bool) and math.isfinite(height)):
+        raise InputError(f"{file}: flight_height_m: {height!r} is not a number")
+    if not isinstance(doc["bounds"], dict):
+        raise InputError(f"{file}: bounds: {doc['bounds']!r} is not an object with min and max")
+    bounds = {k: number_list(file, f"bounds.{k}", doc["bounds"].get(k), 3) for k in ("min", "max")}
     surfaces = []
     for g in root.iter("geom"):
         kind = g.get("type", "sphere")
@@ -106,8 +111,7 @@ def load_mjcf_scene(file):
         surfaces.append({"name": name, "type": kind, "centre_m": pos,
                          "half_size_m": size[:2] if kind == "box" else [size[0], half_z],
                          "level": "rich" if g.get("material") in textured else "plain"})
-    lo, hi = doc["bounds"]["min"], doc["bounds"]["max"]
-    return {"room": {"min_m": lo, "max_m": hi}, "surfaces": surfaces, "start": doc["start"], "goal": doc["goal"]}
+    return {"room": {"min_m": bounds["min"], "max_m": bounds["max"]}, "surfaces": surfaces, "start": doc["start"], "goal": doc["goal"]}
 
 
 def load_scene(path):
@@ -125,18 +129,44 @@ def load_scene(path):
     return check_scene(file, scene)
 
 
+def number_list(file, key, value, count):
+    """`value` as `count` finite numbers (at least `count` with count < 0), or InputError."""
+    ok = isinstance(value, list) and (len(value) == count or (count < 0 and len(value) >= -count))
+    ok = ok and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+    if not ok:
+        raise InputError(f"{file}: {key}: {value!r} is not {abs(count)}{'' if count > 0 else ' or more'} numbers")
+    return value
+
+
 def check_scene(file, scene):
+    if not isinstance(scene, dict):
+        raise InputError(f"{file}: not a JSON object (not a generated.json of tgnav scene generate)")
     for key in ("room", "surfaces", "start", "goal"):
         if key not in scene:
             raise InputError(f"{file}: key '{key}' missing (not a generated.json of tgnav scene generate)")
+    room = scene["room"]
+    if not isinstance(room, dict):
+        raise InputError(f"{file}: room: {room!r} is not an object with min_m and max_m")
+    lo = number_list(file, "room.min_m", room.get("min_m"), -2)
+    hi = number_list(file, "room.max_m", room.get("max_m"), -2)
+    if not (lo[0] < hi[0] and lo[1] < hi[1]):
+        raise InputError(f"{file}: room: min_m {lo} is not below max_m {hi}")
+    if not isinstance(scene["surfaces"], list):
+        raise InputError(f"{file}: surfaces: not a list")
     for i, s in enumerate(scene["surfaces"]):
-        if s.get("type") not in ("box", "cylinder"):
-            raise InputError(f"{file}: surfaces[{i}].type: '{s.get('type')}' is not box or cylinder")
+        if not isinstance(s, dict) or s.get("type") not in ("box", "cylinder"):
+            raise InputError(f"{file}: surfaces[{i}].type: '{s.get('type') if isinstance(s, dict) else s}' "
+                             "is not box or cylinder")
         if s.get("level") not in ("rich", "medium", "faint", "plain"):
             raise InputError(f"{file}: surfaces[{i}].level: '{s.get('level')}' is not rich, medium, faint or plain")
+        number_list(file, f"surfaces[{i}].centre_m", s.get("centre_m"), -2)
+        half = number_list(file, f"surfaces[{i}].half_size_m", s.get("half_size_m"), -2)
+        if min(half[:2]) <= 0:
+            raise InputError(f"{file}: surfaces[{i}].half_size_m: {half} is not positive")
     for key in ("start", "goal"):
         if not (isinstance(scene[key], list) and len(scene[key]) == 4):
             raise InputError(f"{file}: {key}: {scene[key]!r} is not [x, y, z, yaw]")
+        number_list(file, key, scene[key], 4)
     scene["_file"] = file
     base = os.path.basename(file)
     scene["_name"] = (os.path.basename(os.path.dirname(os.path.abspath(file))) if base == "generated.json"
@@ -461,13 +491,21 @@ def check_views(paths, args):
                 raise InputError(f"{folder}: cannot read gt.tum or vo.csv: {e}")
             if gt.shape[1] != 8 or not frames:
                 raise InputError(f"{folder}/gt.tum: not 8 columns (TUM), or vo.csv has no frame")
-            t = np.array([float(r["t"]) for r in frames[1:]])
+            missing = [c for c in ("t", "status", "inliers") if c not in frames[0]]
+            if missing:
+                raise InputError(f"{folder}/vo.csv: column '{missing[0]}' missing")
+            try:
+                t_all = [float(r["t"]) for r in frames[1:]]
+                inl_all = [int(r["inliers"] or 0) for r in frames[1:]]
+            except (TypeError, ValueError) as e:
+                raise InputError(f"{folder}/vo.csv: a row's t or inliers is not a number: {e}")
+            t = np.array(t_all)
             rows = np.clip(np.searchsorted(gt[:, 0], t - 1e-6), 0, len(gt) - 1)
             qx, qy, qz, qw = gt[rows, 4], gt[rows, 5], gt[rows, 6], gt[rows, 7]
             yaw = np.arctan2(2 * (qy * qz - qw * qx), 2 * (qx * qz + qw * qy))  # the optical axis (camera z)
             for a in range(0, len(t), 256):
                 share.extend(view_shares(plane, gt[rows[a:a + 256], 1], gt[rows[a:a + 256], 2], yaw[a:a + 256], args))
-            inliers.extend(int(r["inliers"] or 0) for r in frames[1:])
+            inliers.extend(inl_all)
             lost.extend(r["status"] == "lost" for r in frames[1:])
     share, inliers, lost = np.array(share), np.array(inliers), np.array(lost)
     bins = [0.0, 0.1, 0.2, args.share, 0.5, 1.0 + 1e-9]

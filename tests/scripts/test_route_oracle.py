@@ -164,6 +164,17 @@ class RouteOracleTest(unittest.TestCase):
         r = self.run_oracle(self.write_mjcf("rot", '<geom name="tilted" type="box" pos="5 2 1" size="0.2 0.2 1" euler="0 0 30"/>'))
         self.assertEqual(r.returncode, 2)
         self.assertIn("geom 'tilted': rotated", r.stderr)
+        r = self.run_oracle(self.write_mjcf("size", '<geom name="thin" type="box" pos="5 2 1" size="0.2 x 1"/>'))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("geom 'thin' size: '0.2 x 1' is not 3 numbers", r.stderr)
+        scene = self.write_mjcf("height")
+        with open(scene) as f:
+            text = f.read()
+        with open(scene, "w") as f:
+            f.write(text.replace("flight_height_m: 1.0", "flight_height_m: high"))
+        r = self.run_oracle(scene)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("flight_height_m: 'high' is not a number", r.stderr)
 
     def write_trial(self, scene_folder):
         """A trial in the corridor: 40 frames looking back west at the art (tracked), then 10
@@ -201,6 +212,13 @@ class RouteOracleTest(unittest.TestCase):
         self.assertEqual(got["lost"], 10)
         self.assertEqual(got["rule_tracks"], {"frames": 39, "lost": 0})
         self.assertEqual(sum(b["frames"] for b in got["bins"]), 49)
+        with open(os.path.join(trial, "vo.csv")) as f:
+            vo = f.read()
+        with open(os.path.join(trial, "vo.csv"), "w") as f:
+            f.write(vo.replace("t,status,inliers", "t,status,matches"))
+        r = self.run_oracle("--check-views", trial)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("vo.csv: column 'inliers' missing", r.stderr)
         os.remove(os.path.join(trial, "config.yaml"))
         r = self.run_oracle("--check-views", trial)
         self.assertEqual(r.returncode, 2)
@@ -213,9 +231,18 @@ class RouteOracleTest(unittest.TestCase):
         shiny = corridor()
         shiny["surfaces"][1]["level"] = "shiny"
         blocked = corridor(goal=(12.0, 2.0, 0.0))  # in the east wall
+        no_centre = corridor()
+        del no_centre["surfaces"][0]["centre_m"]
+        text_start = corridor()
+        text_start["start"][1] = "two"
+        flat_room = corridor()
+        flat_room["room"]["max_m"] = [0, 4, 3]
         cases = [(self.write("a", no_surfaces), "key 'surfaces' missing"),
                  (self.write("b", shiny), "surfaces[1].level: 'shiny'"),
                  (self.write("c", blocked), "goal: [12.0, 2.0] has no free cell"),
+                 (self.write("e", no_centre), "surfaces[0].centre_m: None is not 2 or more numbers"),
+                 (self.write("f", text_start), "start: [1.0, 'two', 1.0, 3.14"),
+                 (self.write("g", flat_room), "room: min_m [0, 0, 0] is not below max_m [0, 4, 3]"),
                  (os.path.join(self.dir.name, "none"), "cannot read")]
         for folder, message in cases:
             r = self.run_oracle(folder, "--out", out)
