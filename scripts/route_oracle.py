@@ -39,14 +39,19 @@ Exit status 2 with one line naming the file for bad input, nothing written.
 """
 import argparse
 import collections
+import csv
 import json
 import math
 import os
 import sys
+import xml.etree.ElementTree as ET
 
 import numpy as np
+import yaml
+from scipy import ndimage
 
 TEXTURED = ("rich", "medium")
+MODES = ("prior", "explore", "look_ahead", "any_view")
 
 
 class InputError(Exception):
@@ -68,8 +73,6 @@ def load_mjcf_scene(file):
     the MJCF's box and cylinder geoms (axis-aligned; a rotated one is refused) that reach into the
     flight height +- 0.3 m (the planners' slice) are the blocks; a geom whose material has a texture
     from a file is rich, any other (a colour, a builtin checker) plain."""
-    import xml.etree.ElementTree as ET
-    import yaml
     try:
         with open(file) as f:
             doc = yaml.safe_load(f)
@@ -164,9 +167,7 @@ def check_scene(file, scene):
         if min(half[:2]) <= 0:
             raise InputError(f"{file}: surfaces[{i}].half_size_m: {half} is not positive")
     for key in ("start", "goal"):
-        if not (isinstance(scene[key], list) and len(scene[key]) == 4):
-            raise InputError(f"{file}: {key}: {scene[key]!r} is not [x, y, z, yaw]")
-        number_list(file, key, scene[key], 4)
+        number_list(file, key, scene[key], 4)  # [x, y, z, yaw]
     scene["_file"] = file
     base = os.path.basename(file)
     scene["_name"] = (os.path.basename(os.path.dirname(os.path.abspath(file))) if base == "generated.json"
@@ -201,15 +202,17 @@ class Plane:
                 np.floor((np.asarray(y) - self.lo[1]) / self.fine).astype(int))
 
     def march(self, x0, y0, angles, max_range):
-        """For rays from points (x0, y0) (arrays, n) at angles (m): the distance to the first
-        block (max_range where none) and whether that block is textured, each n x m."""
+        """For rays from points (x0, y0) (arrays, n) at angles (m, the same for every point, or
+        n x m): the distance to the first block (max_range where none) and whether that block is
+        textured, each n x m."""
         steps = np.arange(1, int(math.ceil(max_range / (0.5 * self.fine))) + 1) * 0.5 * self.fine
-        dist = np.full((len(x0), len(angles)), max_range)
-        tex = np.zeros((len(x0), len(angles)), bool)
+        angles = np.broadcast_to(angles, (len(x0), np.shape(angles)[-1]))
+        dist = np.full(angles.shape, max_range)
+        tex = np.zeros(angles.shape, bool)
         c, s = np.cos(angles), np.sin(angles)
-        for j in range(len(angles)):
-            px = x0[:, None] + steps[None, :] * c[j]
-            py = y0[:, None] + steps[None, :] * s[j]
+        for j in range(angles.shape[1]):
+            px = x0[:, None] + steps[None, :] * c[:, j, None]
+            py = y0[:, None] + steps[None, :] * s[:, j, None]
             ix, iy = self.cell(px, py)
             ok = (ix >= 0) & (iy >= 0) & (ix < self.shape[0]) & (iy < self.shape[1])
             lab = np.where(ok, self.label[np.clip(ix, 0, self.shape[0] - 1), np.clip(iy, 0, self.shape[1] - 1)], -1)
@@ -231,7 +234,6 @@ def analyse(scene, args):
     ys = lo[1] + (np.arange(ny) + 0.5) * step
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     # Clearance: a cell is free for the vehicle when no block lies within the robot radius.
-    from scipy import ndimage
     blocked_fine = plane.label >= 0
     clearance = ndimage.distance_transform_edt(~blocked_fine) * plane.fine
     fx, fy = plane.cell(X, Y)
@@ -279,8 +281,7 @@ def analyse(scene, args):
         o = o[o >= 0]
         o = np.unique(o[~known[o]])
         known[o] = True
-        new = o.tolist()
-        return new
+        return o.tolist()
 
     def locate(pose, what):
         """The free cell nearest the pose, which must lie within one cell of it."""
@@ -368,7 +369,7 @@ def analyse(scene, args):
                 "_reached": seen.any(axis=1)}
 
     result = {"scene": scene["_file"], "cells": int(len(cells)), "tracking_share": float(tracks.mean())}
-    for mode in ("prior", "explore", "look_ahead", "any_view"):
+    for mode in MODES:
         result[mode] = search(mode)
         if "_reached" in result[mode]:
             result[mode]["reached_share"] = float(result[mode]["_reached"].mean())
@@ -421,27 +422,14 @@ def view_shares(plane, x, y, yaw, args):
     """The share of each view's rays (61 across the field of view) that end on a textured block
     within the track range, for views at (x, y) looking along yaw (arrays)."""
     half = math.radians(args.hfov_deg) / 2
-    angles = yaw[:, None] + np.linspace(-half, half, 61)[None, :]
-    steps = np.arange(1, int(math.ceil(args.track_range / (0.5 * plane.fine))) + 1) * 0.5 * plane.fine
-    px = x[:, None, None] + steps[None, None, :] * np.cos(angles)[:, :, None]
-    py = y[:, None, None] + steps[None, None, :] * np.sin(angles)[:, :, None]
-    ix, iy = plane.cell(px, py)
-    ok = (ix >= 0) & (iy >= 0) & (ix < plane.shape[0]) & (iy < plane.shape[1])
-    lab = np.where(ok, plane.label[np.clip(ix, 0, plane.shape[0] - 1), np.clip(iy, 0, plane.shape[1] - 1)], -1)
-    hit = lab >= 0
-    first = np.where(hit.any(axis=2), hit.argmax(axis=2), 0)
-    has = hit.any(axis=2)
-    d = steps[first]
-    block = np.take_along_axis(lab, first[:, :, None], axis=2)[:, :, 0]
-    good = has & plane.textured[block] & (d >= args.min_range) & (d <= args.track_range)
-    return good.mean(axis=1)
+    dist, tex = plane.march(x, y, yaw[:, None] + np.linspace(-half, half, 61)[None, :], args.track_range)
+    return (tex & (dist >= args.min_range) & (dist <= args.track_range)).mean(axis=1)
 
 
 def trial_folders(path):
     """A trial folder (vo.csv, gt.tum, config.yaml), or every trial of a sweep folder (index.csv)."""
     index = os.path.join(path, "index.csv")
     if os.path.isfile(index):
-        import csv
         with open(index) as f:
             rows = list(csv.DictReader(f))
         if rows and "folder" not in rows[0]:
@@ -455,7 +443,6 @@ def trial_folders(path):
 def trial_scene(folder, scene_root):
     """The scene a trial flew: its config.yaml's scene (a generated scene's generated.json two
     folders up), or, where that file is gone, the file of that name in scene_root."""
-    import yaml
     file = os.path.join(folder, "config.yaml")
     try:
         with open(file) as f:
@@ -482,7 +469,6 @@ def check_views(paths, args):
         for folder in trial_folders(path):
             scene = trial_scene(folder, args.scene_root)
             plane = Plane(scene, args.fine)
-            import csv
             try:
                 gt = np.loadtxt(os.path.join(folder, "gt.tum"), ndmin=2)
                 with open(os.path.join(folder, "vo.csv")) as f:
@@ -568,24 +554,25 @@ def main(argv):
         if args.figure:
             figure(r, scene, args.figure)
         if args.paths:
-            write_paths(r, scene, args.paths, scene.get("flight_height_m", scene["start"][2]))
+            write_paths(r, scene, args.paths)
         del r["_draw"]
-        for mode in ("prior", "explore", "look_ahead", "any_view"):
+        for mode in MODES:
             r[mode].pop("_reached", None)
         results.append(r)
         print(f"{scene['_file']}: " + ", ".join(f"{m} " + (f"{r[m]['path_length_m']:.1f} m" if r[m]["reached"] else "no")
-                                                  for m in ("prior", "explore", "look_ahead", "any_view"))
+                                                  for m in MODES)
               + f" (views that track {r['tracking_share']:.2f}, explore knew {r['explore']['known_share']:.2f})")
     print("reach the goal: " + ", ".join(f"{m} {sum(r[m]['reached'] for r in results)}/{len(results)}"
-                                         for m in ("prior", "explore", "look_ahead", "any_view")))
+                                         for m in MODES))
     write_json(args.out, {"settings": vars(args), "scenes": results})
     return 0
 
 
-def write_paths(result, scene, out_dir, height):
-    """Each route found (prior, explore) as a 4-DoF path CSV for `tgnav trial --path` (x,y,z,yaw):
-    the scene's start, one point per cell with the last yaw held there (unwrapped, so the
-    trajectory turns the way the search did), and the goal's position."""
+def write_paths(result, scene, out_dir):
+    """Each route found (prior, explore) as a 4-DoF path CSV for `tgnav trial --path` (x,y,z,yaw),
+    at the start's height: the scene's start, one point per cell with the last yaw held there
+    (unwrapped, so the trajectory turns the way the search did), and the goal's position."""
+    height = scene["start"][2]
     os.makedirs(out_dir, exist_ok=True)
     for mode in ("prior", "explore"):
         if not result[mode]["reached"]:
