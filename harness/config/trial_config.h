@@ -135,6 +135,13 @@ struct OnlineConfig {
   // see the way on; the next plan, made once the map has grown, sends the vehicle on
   // (harness/run/look_ahead.h, stopBeforeUnknown).
   bool stop_before_unknown = false;
+  // Look, then fly (harness/run/explore.h; proposed and rrtstar): where the plan's route runs into
+  // unknown space, the vehicle flies instead, through observed free space and with every view rated
+  // trackable on the map so far (and expecting at least guard_inliers detections), to the place and
+  // yaw whose trackable view observes most of the unknown way on, and stops there; the next plan goes
+  // on from what it saw. Where that search reaches the goal, its way there is flown. agnostic ignores
+  // it (it has no perception model).
+  bool look_then_fly = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
@@ -193,6 +200,7 @@ struct OnlineConfig {
     a("plan_look_ahead", plan_look_ahead);
     a("hold_first_plan", hold_first_plan);
     a("stop_before_unknown", stop_before_unknown);
+    a("look_then_fly", look_then_fly);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);

@@ -21,16 +21,18 @@ constexpr double kNearMarginRad = 5.0 * M_PI / 180.0;
 constexpr double kRenewWindowS = 5.0;
 }  // namespace
 
-void ViewRater::moveTo(const Eigen::Vector3d& p_WB) {
+void ViewRater::moveTo(const Eigen::Vector3d& p_WB, const std::function<bool(const planner::LandmarkVoxel&)>& keep) {
   p_WB_ = p_WB;
-  points_ = planner::aggregateSlots(*voxels_, voxels_->visibleSlots(p_WB, *visibility_));
+  points_ = planner::aggregateSlots(*voxels_, voxels_->visibleSlots(p_WB, *visibility_, keep));
 }
 
 double ViewRater::shortfall(double yaw_rad) const {
   planner::ViewSupport support;
   planner::poseInformation(planner::cameraPosition(p_WB_, yaw_rad, *visibility_), yaw_rad, points_, *visibility_,
                            *information_, &support);
-  return planner::gateShortfall(support, *information_);
+  const double gates = planner::gateShortfall(support, *information_);
+  if (support.detections >= detection_floor_) return gates;
+  return std::max(gates, 1.0 - support.detections / detection_floor_);
 }
 
 double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit) {

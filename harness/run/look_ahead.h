@@ -3,6 +3,7 @@
 // that turns it toward unknown space before the vehicle flies there, within the trajectory's
 // yaw-rate limit.
 #include <Eigen/Core>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -33,10 +34,14 @@ class ViewRater {
             const planner::InformationConfig& information)
       : voxels_(&voxels), visibility_(&visibility), information_(&information) {}
   // The landmarks a camera with the body at p_WB sees at any yaw (the pose graph's V(p)); the
-  // views asked next are from there.
-  void moveTo(const Eigen::Vector3d& p_WB);
+  // views asked next are from there. With `keep`, only the landmark voxels it accepts (asked before
+  // the line of sight; e.g. those seen across observed space only, explore.h).
+  void moveTo(const Eigen::Vector3d& p_WB, const std::function<bool(const planner::LandmarkVoxel&)>& keep = {});
   // The shortfall of the view along yaw_rad from where moveTo() put the body.
   double shortfall(double yaw_rad) const;
+  // A gate on top of the model's (or the configured gates): a view expecting fewer than this many
+  // detections (planner::ViewSupport::detections) falls short by 1 - detections / floor.
+  void setDetectionFloor(double detections) { detection_floor_ = detections; }
 
  private:
   const planner::VoxelMap* voxels_;
@@ -44,6 +49,7 @@ class ViewRater {
   const planner::InformationConfig* information_;
   Eigen::Vector3d p_WB_ = Eigen::Vector3d::Zero();
   std::vector<planner::WeightedPoint> points_;
+  double detection_floor_ = 0.0;
 };
 
 // The share (0: `planned`, 1: `look`) of the turn from the planner's yaw to the look-ahead's that

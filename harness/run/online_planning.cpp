@@ -9,6 +9,7 @@
 
 #include "harness/base/clock.h"
 #include "harness/base/errors.h"
+#include "harness/run/explore.h"
 #include "harness/run/look_ahead.h"
 #include "harness/run/online_metrics.h"
 #include "harness/run/unseen_prior.h"
@@ -43,7 +44,8 @@ struct OnlinePlanning::Attempt {
   std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
   std::optional<control::SetpointTrajectory> raw;         // the planner's
   std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
-  bool stops_short = false;  // its trajectory ends before the path does (stop_before_unknown)
+  bool stops_short = false;            // its trajectory ends before the path does (stop_before_unknown)
+  std::optional<planner::Pose4> look;  // trial.look_then_fly: its trajectory ends at this look pose
 };
 
 OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey,
@@ -144,6 +146,13 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
     a.record.path.push_back(p.p_WB);
     a.record.path_unknown.push_back(!built.map.isKnown(p.p_WB));
   }
+  if (cfg_.look_then_fly && !external_ && planner_ != planner::PlannerKind::kAgnostic &&
+      lookFirst(from_here, built.map, clear_m, &a)) {
+    if (!a.record.ok) return a;  // no view to look from: the vehicle holds
+    a.trajectory = *a.raw;       // its yaws are the views it chose: no look-ahead
+    a.map = std::move(built.map);
+    return a;
+  }
   if (cfg_.stop_before_unknown && !external_) {
     // Observed: the robot radius and two voxels around the path (as the free places of `blocked`).
     StopRule rule;
@@ -172,6 +181,59 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map, *a.run.voxels);
   a.map = std::move(built.map);
   return a;
+}
+
+bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a) {
+  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
+  StopRule rule;
+  rule.clear_m = clear_m;
+  rule.half_fov_rad = lookAheadHalfFov(perception);
+  const std::vector<planner::Pose4> known = stopBeforeUnknown(a->run.plan.path, map, visited_, rule);
+  const bool all_observed = known.size() >= a->run.plan.path.size();
+  std::vector<Eigen::Vector3d> way_on;
+  for (std::size_t i = known.size(); i < a->run.plan.path.size(); ++i) way_on.push_back(a->run.plan.path[i].p_WB);
+  LookConfig look;
+  look.robot_radius_m = perception.robot_radius_m;
+  look.known_m = perception.robot_radius_m;  // the body never overlaps unknown space
+  look.flight_height_m = from_here.scene.flight_height_m;
+  look.half_hfov_rad = 0.5 * perception.visibility.hfov_rad;
+  look.observe_range_m = cfg_.map_range_m;
+  look.turn_m_per_rad =
+      scenario_.planner.trajectory.nominal_speed_mps / scenario_.planner.trajectory.nominal_yaw_rate_rad_s;
+  look.visited_clear_m = clear_m;
+  look.way_clear_m = clear_m;
+  // The views it flies must expect as many detections as the tracking guard asks of inliers (the
+  // model's probability alone rated views trackable where the VO found 50-80 features for seconds
+  // and was lost: development scene detour-5003).
+  ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
+  rater.setDetectionFloor(cfg_.guard_inliers);
+  const LookPlan found = planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, way_on,
+                                  visited_, looked_, result_.guards, look);
+  a->record.look_cells = found.cells;
+  // A route all observed that the search cannot fly with trackable views: flown as planned.
+  if (all_observed && !found.goal) return false;
+  a->record.look_seen = found.seen;
+  a->record.look_way = found.way;
+  a->record.look_goal = found.goal;
+  if (found.path.size() < 2) {
+    a->record.ok = false;
+    a->record.detail =
+        "look_then_fly: the route runs into unknown space and no trackable view reached through "
+        "observed space observes any";
+    return true;
+  }
+  a->run.plan.path = found.path;
+  smoothPath(from_here, a->run.plan.path, nullptr, &a->run);
+  a->record.trajectory_s += a->run.trajectory_s;
+  if (!a->run.trajectory.trajectory) {
+    a->record.ok = false;
+    a->record.detail = "look_then_fly: trajectory generation failed: " + a->run.trajectory.reason;
+    return true;
+  }
+  a->raw = setpoints(a->run, scenario_.planner.trajectory.sample_rate_hz);
+  a->stops_short = !found.goal;
+  if (!found.goal) a->look = found.path.back();
+  return true;
 }
 
 OnlinePlanning::Attempt OnlinePlanning::planClearOf(const planner::Pose4& start, double t_s,
@@ -252,6 +314,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   if (a.trajectory && !cfg_.hold_first_plan) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
+    if (a.look) looked_.push_back(*a.look);
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
   } else {
@@ -343,7 +406,7 @@ void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahea
 void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   const std::optional<control::SetpointTrajectory> renewed =
       renewedViews(*current_, *a.raw, tau_switch, scenario_.planner.trajectory.max_yaw_rate_rad_s);
-  if (renewed) switchTo(lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  if (renewed) switchTo(a.look ? *renewed : lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
@@ -445,6 +508,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   if (a.trajectory) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
+    if (a.look) looked_.push_back(*a.look);
     last_change_s_ = t_s;
     switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
     pending_until_s_ = t_eff;

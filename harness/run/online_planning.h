@@ -68,6 +68,14 @@ struct OnlinePlan {
   double route_blind_m = -1.0;
   double chosen_length_m = -1.0;  // ... and their lengths (planner::CandidatePath::length_m)
   double route_length_m = -1.0;
+  // trial.look_then_fly: -1 where the route was flown as planned (not asked, or all observed and
+  // the search found no way to the goal with trackable views); else the unknown cells the look
+  // pose's view observes (0: none does, and the plan fails: the vehicle holds; or look_goal), of the
+  // way on (look_way) or of any unknown space. look_goal: the search's way to the goal was flown.
+  int look_seen = -1;
+  bool look_way = false;
+  bool look_goal = false;
+  int look_cells = 0;        // cells whose views the search rated
   int landmarks = 0;         // in the map it planned on
   int prior_landmarks = 0;   // ... and those of trial.unseen_prior added to it (unseen_prior.h)
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
@@ -157,6 +165,10 @@ class OnlinePlanning {
   // plan(), and where a built-in planner finds `start` within the robot radius of the map
   // (`invalid_start`), plan() again from the nearest point that clears it (record.start_shift_m).
   Attempt planClearOf(const planner::Pose4& start, double t_s, const std::string& trigger);
+  // trial.look_then_fly: false where a's route is all observed (flown as planned); else true, and
+  // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
+  // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
+  bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
   void makeGuard(const Intrinsics& camera);  // trial.guard_tracking's guard, its lead with `camera`
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
@@ -201,6 +213,7 @@ class OnlinePlanning {
   bool stops_short_ = false;              // the trajectory flown stops short of unknown space
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
+  std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
   OnlineResult result_;
 };
 

@@ -214,6 +214,10 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["route_blind_m"] = p.route_blind_m;
     j["chosen_length_m"] = p.chosen_length_m;
     j["route_length_m"] = p.route_length_m;
+    j["look_seen"] = p.look_seen;
+    j["look_way"] = p.look_way;
+    j["look_goal"] = p.look_goal;
+    j["look_cells"] = p.look_cells;
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();

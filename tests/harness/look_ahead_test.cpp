@@ -167,6 +167,19 @@ TEST(LookAhead, KeepsTheViewTrackableAsFarTowardTheWayAheadAsItMay) {
   EXPECT_GE(limited, 55.0 * kDeg - 1e-9);
 }
 
+TEST(LookAhead, ADetectionFloorRatesAViewTheModelPassesShort) {
+  WallViews wall;
+  ViewRater& rater = wall.rater;
+  rater.moveTo(Eigen::Vector3d(1.75, 0.0, 1.0));
+  ASSERT_EQ(rater.shortfall(0.0), 0.0);
+  rater.setDetectionFloor(1.0);  // far below what the wall promises: no change
+  EXPECT_EQ(rater.shortfall(0.0), 0.0);
+  rater.setDetectionFloor(1e6);
+  const double short_of = rater.shortfall(0.0);
+  EXPECT_GT(short_of, 0.99);
+  EXPECT_LT(short_of, 1.0);
+}
+
 TEST(LookAhead, TheBestViewKeepsTheWayAheadInViewOnTheSideOfTheTexture) {
   WallViews wall;
   ViewRater& rater = wall.rater;

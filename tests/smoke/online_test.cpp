@@ -205,6 +205,35 @@ TEST(OnlineTrial, HoldingTheFirstPlanFliesTheOneMadeOnWhatTheCameraMappedAndTheR
   EXPECT_LT(near[1]["landmarks"].get<int>(), plain[1]["landmarks"].get<int>());
 }
 
+TEST(OnlineTrial, LookThenFlyHoldsUntilAViewCanBeFlownAndNeverFliesWhereItsMapIsBlind) {
+  // trial.look_then_fly: at take-off nothing is mapped, no view rates trackable, so the first plan
+  // fails and the vehicle climbs and holds; the plans after it search the map its camera made.
+  // AP (no perception model) ignores the option.
+  const auto dir = test::tempDir();
+  const std::string args =
+      "--online --seed 3" + kSmall + " --set trial.max_flight_s=4.5 --set trial.look_then_fly=true";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "look").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --planner agnostic --out " + (dir / "ap").string())).rc, 0);
+  const nlohmann::json look = readJson(dir / "look/online.json")["plans"];
+  const nlohmann::json ap = readJson(dir / "ap/online.json")["plans"];
+  ASSERT_GE(look.size(), 2U);
+  EXPECT_FALSE(look[0]["ok"].get<bool>());
+  EXPECT_EQ(look[0]["detail"].get<std::string>().rfind("look_then_fly: ", 0), 0U) << look[0]["detail"];
+  EXPECT_EQ(look[0]["landmarks"], 0);
+  for (std::size_t i = 1; i < look.size(); ++i) {
+    std::cout << "[ figure   ] plan at " << look[i]["t_s"] << " s: " << look[i]["landmarks"] << " landmarks, "
+              << look[i]["look_cells"] << " cells rated, sees " << look[i]["look_seen"]
+              << " unknown cells, to the goal " << look[i]["look_goal"] << ", " << look[i]["detail"] << "\n";
+    EXPECT_GT(look[i]["look_cells"].get<int>(), 0);  // the search ran on what was mapped
+  }
+  const nlohmann::json metrics = readJson(dir / "look/metrics.json");
+  EXPECT_TRUE(metrics["collision"].is_null());
+  ASSERT_GE(ap.size(), 1U);
+  EXPECT_TRUE(ap[0]["ok"].get<bool>());
+  EXPECT_EQ(ap[0]["look_seen"], -1);
+  EXPECT_EQ(ap[0]["look_cells"], 0);
+}
+
 TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
   const auto dir = test::tempDir();
   // The example A* planner behind a guard that makes a second start of the command fail.

@@ -1,0 +1,420 @@
+#include "harness/run/explore.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
+
+namespace tgnav::harness {
+
+namespace {
+
+constexpr double kRayStepRad = 2.0 * M_PI / 180.0;  // the rays a cell's views are counted on
+// The last stretch of a line of sight to a landmark's voxel that may cross unknown columns (the
+// surface's own voxel, and the one before it that depth seldom fills).
+constexpr double kSurfaceEndM = 0.2;
+
+double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+// The voxel columns at the flight height, as the search sees them.
+class Columns {
+ public:
+  Columns(const planner::VoxelMap& voxels, const LookConfig& config, const std::vector<Eigen::Vector3d>& visited)
+      : res_(voxels.resolution()),
+        origin_(voxels.origin().head<2>()),
+        nx_(voxels.size().x()),
+        ny_(voxels.size().y()),
+        occupied_(static_cast<std::size_t>(nx_) * ny_, 0),
+        known_(occupied_.size(), 0),
+        seen_(occupied_.size(), 0) {
+    const double h = config.flight_height_m;
+    const int layers = static_cast<int>(std::ceil(config.robot_radius_m / res_));
+    for (int j = 0; j < ny_; ++j) {
+      for (int i = 0; i < nx_; ++i) {
+        const Eigen::Vector2d c = centre(i, j);
+        const std::size_t at = index(i, j);
+        for (int dz = -layers; dz <= layers; ++dz) {
+          if (voxels.state(Eigen::Vector3d(c.x(), c.y(), h + dz * res_)) == planner::VoxelState::kOccupied) {
+            occupied_[at] = 1;
+          }
+        }
+        const bool observed = voxels.observed(Eigen::Vector3d(c.x(), c.y(), h));
+        double nearest = std::numeric_limits<double>::infinity();  // to a visited place
+        if (!observed) {
+          for (const Eigen::Vector3d& v : visited) nearest = std::min(nearest, (v.head<2>() - c).norm());
+        }
+        known_[at] = observed || nearest <= config.visited_clear_m ? 1 : 0;
+        seen_[at] = observed || nearest <= config.robot_radius_m ? 1 : 0;
+      }
+    }
+  }
+  double res() const { return res_; }
+  int nx() const { return nx_; }
+  int ny() const { return ny_; }
+  Eigen::Vector2d centre(int i, int j) const { return origin_ + res_ * Eigen::Vector2d(i + 0.5, j + 0.5); }
+  bool inside(int i, int j) const { return i >= 0 && j >= 0 && i < nx_ && j < ny_; }
+  std::size_t index(int i, int j) const { return static_cast<std::size_t>(j) * nx_ + i; }
+  std::pair<int, int> cellOf(const Eigen::Vector2d& p) const {
+    return {static_cast<int>(std::floor((p.x() - origin_.x()) / res_)),
+            static_cast<int>(std::floor((p.y() - origin_.y()) / res_))};
+  }
+  bool occupied(std::size_t at) const { return occupied_[at] != 0; }
+  bool known(std::size_t at) const { return known_[at] != 0; }
+  // Whether the segment from p to q crosses only observed columns (occupied or free; of visited
+  // places, only the disc of the robot radius) before its last `end_m`: what lies across unknown
+  // space may be hidden by what is not mapped yet.
+  bool knownLine(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double end_m) const {
+    const double length = (q - p).norm();
+    const double dr = 0.5 * res_;
+    for (double d = 0.0; d < length - end_m; d += dr) {
+      const auto [i, j] = cellOf(p + (d / length) * (q - p));
+      if (!inside(i, j) || seen_[index(i, j)] == 0) return false;
+    }
+    return true;
+  }
+  // No column within `radius` of p occupied, and every one within `known_m` of it observed.
+  bool clear(const Eigen::Vector2d& p, double radius, double known_m) const {
+    const int reach = static_cast<int>(std::ceil(std::max(radius, known_m) / res_)) + 1;
+    const auto [ci, cj] = cellOf(p);
+    for (int j = cj - reach; j <= cj + reach; ++j) {
+      for (int i = ci - reach; i <= ci + reach; ++i) {
+        if (!inside(i, j)) return false;
+        // The nearest point of the column's square to p.
+        const Eigen::Vector2d lo = origin_ + res_ * Eigen::Vector2d(i, j);
+        const double d = (p.cwiseMax(lo).cwiseMin(lo + Eigen::Vector2d::Constant(res_)) - p).norm();
+        const std::size_t at = index(i, j);
+        if ((d <= radius && occupied(at)) || (d <= known_m && !known(at))) return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  double res_;
+  Eigen::Vector2d origin_;
+  int nx_;
+  int ny_;
+  std::vector<std::uint8_t> occupied_;
+  std::vector<std::uint8_t> known_;  // observed, or within visited_clear_m of a visited place
+  std::vector<std::uint8_t> seen_;   // observed, or within the robot radius of one
+};
+
+// What the views from one cell observe: per ray (kRayStepRad apart from angle 0), the unknown
+// columns it first reaches, of the way on and of any.
+struct CellSight {
+  std::vector<int> way;
+  std::vector<int> any;
+};
+
+// The search of planLook() over (cell, yaw) states: state = cell * yaws + yaw index.
+class LookSearch {
+ public:
+  LookSearch(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
+             const std::vector<Eigen::Vector3d>& visited, const std::vector<GuardEvent>& tripped,
+             const LookConfig& config)
+      : config_(config),
+        columns_(voxels, config, visited),
+        rater_(rater),
+        tripped_(tripped),
+        lo_(voxels.origin().head<2>()),
+        start_(start) {
+    const Eigen::Vector2d extent = voxels.size().head<2>().cast<double>() * voxels.resolution();
+    gx_ = std::max(1, static_cast<int>(std::floor(extent.x() / config.cell_m)));
+    gy_ = std::max(1, static_cast<int>(std::floor(extent.y() / config.cell_m)));
+    yaws_ = std::max(1, static_cast<int>(std::lround(2.0 * M_PI / config.yaw_step_rad)));
+    step_ = 2.0 * M_PI / yaws_;
+    const std::size_t cells = static_cast<std::size_t>(gx_) * gy_;
+    clear_.assign(cells, -1);
+    trackable_.resize(cells);
+    sight_.resize(cells);
+    stamp_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), -1);
+    const Eigen::Vector2d s = start.p_WB.head<2>();
+    const int si = std::clamp(static_cast<int>(std::floor((s.x() - lo_.x()) / config.cell_m)), 0, gx_ - 1);
+    const int sj = std::clamp(static_cast<int>(std::floor((s.y() - lo_.y()) / config.cell_m)), 0, gy_ - 1);
+    start_cell_ = sj * gx_ + si;
+    const int k = static_cast<int>(std::lround(std::remainder(start.yaw_rad, 2.0 * M_PI) / step_ + yaws_)) % yaws_;
+    start_state_ = start_cell_ * yaws_ + k;
+  }
+
+  // Dijkstra from the start (allowed as it is, whatever its view) up to config.max_cost_m: a move
+  // keeps the yaw and goes to one of the 8 neighbouring cells, clear, with that yaw trackable; a
+  // turn changes the yaw by one step, trackable, where it is.
+  void run() {
+    cost_.assign(static_cast<std::size_t>(gx_) * gy_ * yaws_, std::numeric_limits<double>::infinity());
+    prev_.assign(cost_.size(), -1);
+    std::vector<std::uint8_t> done(cost_.size(), 0);
+    using Entry = std::pair<double, int>;
+    std::priority_queue<Entry, std::vector<Entry>, std::greater<>> open;
+    const auto relax = [&](int from, int to, double c) {
+      if (c > config_.max_cost_m || c >= cost_[at(to)]) return;
+      cost_[at(to)] = c;
+      prev_[at(to)] = from;
+      open.emplace(c, to);
+    };
+    cost_[at(start_state_)] = 0.0;
+    open.emplace(0.0, start_state_);
+    const double turn_cost = step_ * config_.turn_m_per_rad;
+    while (!open.empty()) {
+      const auto [c, s] = open.top();
+      open.pop();
+      if (done[at(s)]) continue;
+      done[at(s)] = 1;
+      settled_.push_back(s);
+      const int cell = s / yaws_;
+      const int k = s % yaws_;
+      for (int dk : {-1, 1}) {
+        const int k2 = (k + dk + yaws_) % yaws_;
+        if (trackable(cell)[at(k2)]) relax(s, cell * yaws_ + k2, c + turn_cost);
+      }
+      const int ci = cell % gx_;
+      const int cj = cell / gx_;
+      for (int dj = -1; dj <= 1; ++dj) {
+        for (int di = -1; di <= 1; ++di) {
+          if ((di == 0 && dj == 0) || ci + di < 0 || cj + dj < 0 || ci + di >= gx_ || cj + dj >= gy_) continue;
+          const int next = (cj + dj) * gx_ + ci + di;
+          if (!clear(next) || !trackable(next)[at(k)]) continue;
+          relax(s, next * yaws_ + k, c + config_.cell_m * std::hypot(di, dj));
+        }
+      }
+    }
+  }
+
+  // The least-cost state it reached in the cell of p (-1: none).
+  int reached(const Eigen::Vector2d& p) const {
+    const int i = static_cast<int>(std::floor((p.x() - lo_.x()) / config_.cell_m));
+    const int j = static_cast<int>(std::floor((p.y() - lo_.y()) / config_.cell_m));
+    if (i < 0 || j < 0 || i >= gx_ || j >= gy_) return -1;
+    for (const int s : settled_) {
+      if (s / yaws_ == j * gx_ + i) return s;  // settled in order of cost
+    }
+    return -1;
+  }
+
+  // The look pose among the states reached (planLook()), into out->seen and out->way; -1: none.
+  int chooseLook(const std::vector<Eigen::Vector3d>& way_on, const std::vector<planner::Pose4>& looked, LookPlan* out) {
+    markWay(way_on);
+    std::vector<int> way_seen(settled_.size(), 0);
+    std::vector<int> any_seen(settled_.size(), 0);
+    int best_way = 0;
+    int best_any = 0;
+    for (std::size_t n = 0; n < settled_.size(); ++n) {
+      const int s = settled_[n];
+      if (s == start_state_ || repeats(s, looked)) continue;  // the view it has now, or one flown to
+      const CellSight& cs = sight(s / yaws_);
+      way_seen[n] = seenAlong(cs.way, yawOf(s % yaws_));
+      any_seen[n] = seenAlong(cs.any, yawOf(s % yaws_));
+      best_way = std::max(best_way, way_seen[n]);
+      best_any = std::max(best_any, any_seen[n]);
+    }
+    out->way = best_way > 0;
+    const std::vector<int>& seen = out->way ? way_seen : any_seen;
+    const int best = out->way ? best_way : best_any;
+    if (best <= 0) return -1;
+    // The nearest that sees at least half as much as the best; at equal cost, the one that sees more.
+    int chosen = -1;
+    for (std::size_t n = 0; n < settled_.size(); ++n) {
+      if (2 * seen[n] < best) continue;
+      const double c = cost_[at(settled_[n])];
+      if (chosen >= 0) {
+        const double c0 = cost_[at(settled_[at(chosen)])];
+        if (c > c0 + 1e-9 || (c >= c0 - 1e-9 && seen[n] <= seen[at(chosen)])) continue;
+      }
+      chosen = static_cast<int>(n);
+    }
+    out->seen = seen[at(chosen)];
+    return settled_[at(chosen)];
+  }
+
+  // The poses from the start to `target`: the start as given, cell centres at the flight height,
+  // yaws unwrapped from the start's; straight moves at one yaw merged.
+  std::vector<planner::Pose4> pathTo(int target) const {
+    std::vector<int> chain;
+    for (int s = target; s >= 0; s = prev_[at(s)]) chain.push_back(s);
+    std::reverse(chain.begin(), chain.end());
+    std::vector<planner::Pose4> poses{start_};
+    poses.front().p_WB.z() = config_.flight_height_m;
+    for (std::size_t n = 1; n < chain.size(); ++n) {
+      const Eigen::Vector2d c = place(chain[n] / yaws_);
+      const double yaw = poses.back().yaw_rad + wrapAngle(yawOf(chain[n] % yaws_) - poses.back().yaw_rad);
+      poses.push_back(planner::Pose4{Eigen::Vector3d(c.x(), c.y(), config_.flight_height_m), yaw});
+    }
+    std::vector<planner::Pose4> path;
+    for (const planner::Pose4& p : poses) {
+      if (path.size() >= 2 && straight(path[path.size() - 2], path.back(), p)) path.pop_back();
+      path.push_back(p);
+    }
+    return path;
+  }
+
+  double cost(int state) const { return cost_[at(state)]; }
+  int states() const { return static_cast<int>(settled_.size()); }
+  int cellsRated() const { return cells_rated_; }
+
+ private:
+  static std::size_t at(int i) { return static_cast<std::size_t>(i); }
+  double yawOf(int k) const { return wrapAngle(k * step_); }
+  Eigen::Vector2d centre(int cell) const {
+    const int i = cell % gx_;
+    const int j = cell / gx_;  // the row
+    return lo_ + config_.cell_m * Eigen::Vector2d(i + 0.5, j + 0.5);
+  }
+  // Where the vehicle is in a cell: its centre, or, in the start's, the start itself.
+  Eigen::Vector2d place(int cell) const {
+    return cell == start_cell_ ? Eigen::Vector2d(start_.p_WB.head<2>()) : centre(cell);
+  }
+
+  bool clear(int cell) {
+    std::int8_t& c = clear_[at(cell)];
+    if (c < 0) c = columns_.clear(centre(cell), config_.robot_radius_m + columns_.res(), config_.known_m) ? 1 : 0;
+    return c == 1;
+  }
+
+  // Per yaw, whether the view from the cell rates trackable (and the guard did not trip on it).
+  const std::vector<std::uint8_t>& trackable(int cell) {
+    std::vector<std::uint8_t>& t = trackable_[at(cell)];
+    if (!t.empty()) return t;
+    const Eigen::Vector2d c = place(cell);
+    // A landmark counts only where the way to it runs through observed space: the voxel map's line
+    // of sight passes through unknown space, where a surface not yet mapped may hide it.
+    rater_.moveTo(Eigen::Vector3d(c.x(), c.y(), config_.flight_height_m), [&](const planner::LandmarkVoxel& v) {
+      return columns_.knownLine(c, v.centre_W.head<2>(), kSurfaceEndM);
+    });
+    t.resize(at(yaws_));
+    for (int k = 0; k < yaws_; ++k) {
+      const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
+        return trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
+      });
+      t[at(k)] = !ruled_out && rater_.shortfall(yawOf(k)) <= 0.0 ? 1 : 0;
+    }
+    ++cells_rated_;
+    return t;
+  }
+
+  // The unknown columns within config.way_clear_m of the way on.
+  void markWay(const std::vector<Eigen::Vector3d>& way_on) {
+    on_way_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), 0);
+    const int reach = static_cast<int>(std::ceil(config_.way_clear_m / columns_.res()));
+    for (const Eigen::Vector3d& p : way_on) {
+      const auto [ci, cj] = columns_.cellOf(p.head<2>());
+      for (int j = cj - reach; j <= cj + reach; ++j) {
+        for (int i = ci - reach; i <= ci + reach; ++i) {
+          if (!columns_.inside(i, j) || (columns_.centre(i, j) - p.head<2>()).norm() > config_.way_clear_m) continue;
+          const std::size_t c = columns_.index(i, j);
+          if (!columns_.known(c) && !columns_.occupied(c)) on_way_[c] = 1;
+        }
+      }
+    }
+  }
+
+  // What the cell's views observe: rays kRayStepRad apart to config.observe_range_m, through
+  // unknown columns (optimistic), stopping at occupied ones.
+  const CellSight& sight(int cell) {
+    CellSight& s = sight_[at(cell)];
+    if (!s.way.empty()) return s;
+    const int rays = static_cast<int>(std::lround(2.0 * M_PI / kRayStepRad));
+    s.way.assign(at(rays), 0);
+    s.any.assign(at(rays), 0);
+    const Eigen::Vector2d from = place(cell);
+    const double dr = 0.5 * columns_.res();
+    for (int r = 0; r < rays; ++r) {
+      const Eigen::Vector2d dir(std::cos(r * kRayStepRad), std::sin(r * kRayStepRad));
+      for (double d = dr; d <= config_.observe_range_m; d += dr) {
+        const auto [i, j] = columns_.cellOf(from + d * dir);
+        if (!columns_.inside(i, j)) break;
+        const std::size_t c = columns_.index(i, j);
+        if (columns_.occupied(c)) break;
+        if (columns_.known(c) || stamp_[c] == cell) continue;
+        stamp_[c] = cell;
+        ++s.any[at(r)];
+        if (on_way_[c]) ++s.way[at(r)];
+      }
+    }
+    return s;
+  }
+
+  // The unknown columns a view along yaw observes, of those per ray.
+  int seenAlong(const std::vector<int>& per_ray, double yaw) const {
+    const int rays = static_cast<int>(per_ray.size());
+    const int half = static_cast<int>(std::floor(config_.half_hfov_rad / kRayStepRad));
+    const int mid = static_cast<int>(std::lround(wrapAngle(yaw) / kRayStepRad));
+    int n = 0;
+    for (int r = mid - half; r <= mid + half; ++r) n += per_ray[at((r % rays + rays) % rays)];
+    return n;
+  }
+
+  bool repeats(int state, const std::vector<planner::Pose4>& looked) const {
+    const Eigen::Vector2d p = place(state / yaws_);
+    return std::any_of(looked.begin(), looked.end(), [&](const planner::Pose4& l) {
+      return (l.p_WB.head<2>() - p).norm() <= config_.repeat_m &&
+             std::abs(wrapAngle(l.yaw_rad - yawOf(state % yaws_))) <= 1.01 * step_;
+    });
+  }
+
+  // b lies on the straight line from a on to c, all three at one yaw.
+  static bool straight(const planner::Pose4& a, const planner::Pose4& b, const planner::Pose4& c) {
+    const Eigen::Vector2d ab = (b.p_WB - a.p_WB).head<2>();
+    const Eigen::Vector2d bc = (c.p_WB - b.p_WB).head<2>();
+    return ab.norm() > 1e-9 && bc.norm() > 1e-9 && std::abs(ab.x() * bc.y() - ab.y() * bc.x()) < 1e-9 &&
+           ab.dot(bc) > 0.0 && a.yaw_rad == b.yaw_rad && b.yaw_rad == c.yaw_rad;
+  }
+
+  const LookConfig& config_;
+  const Columns columns_;
+  ViewRater& rater_;
+  const std::vector<GuardEvent>& tripped_;
+  Eigen::Vector2d lo_;
+  planner::Pose4 start_;
+  int gx_ = 1;
+  int gy_ = 1;
+  int yaws_ = 1;
+  double step_ = 2.0 * M_PI;
+  int start_cell_ = 0;
+  int start_state_ = 0;
+  std::vector<std::int8_t> clear_;                    // per cell: -1 not asked yet
+  std::vector<std::vector<std::uint8_t>> trackable_;  // per cell, per yaw (empty: not rated yet)
+  std::vector<CellSight> sight_;                      // per cell (empty: not cast yet)
+  std::vector<int> stamp_;                            // per column: the cell whose rays reached it last
+  std::vector<std::uint8_t> on_way_;                  // per column
+  std::vector<double> cost_;                          // per state
+  std::vector<int> prev_;                             // per state
+  std::vector<int> settled_;                          // in order of cost
+  int cells_rated_ = 0;
+};
+
+}  // namespace
+
+bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m,
+                 double beyond_rad) {
+  if ((event.wedge.apex.head<2>() - p).norm() > within_m) return false;
+  const double turn = wrapAngle(event.yaw_rad - event.good_yaw_rad);
+  const double sign = turn >= 0.0 ? 1.0 : -1.0;
+  const double along = sign * wrapAngle(yaw_rad - event.good_yaw_rad);  // in the turn's direction
+  return along >= 0.5 * std::abs(turn) && along <= std::abs(turn) + beyond_rad;
+}
+
+LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
+                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& way_on,
+                  const std::vector<Eigen::Vector3d>& visited, const std::vector<planner::Pose4>& looked,
+                  const std::vector<GuardEvent>& tripped, const LookConfig& config) {
+  LookPlan out;
+  LookSearch search(voxels, rater, start, visited, tripped, config);
+  search.run();
+  out.states = search.states();
+  int target = search.reached(goal.head<2>());
+  out.goal = target >= 0;
+  if (!out.goal) target = search.chooseLook(way_on, looked, &out);
+  out.cells = search.cellsRated();
+  if (target < 0) return out;
+  out.cost_m = search.cost(target);
+  out.path = search.pathTo(target);
+  if (out.goal) {
+    if (out.path.size() == 1) out.path.push_back(start);  // already in the goal's cell
+    out.path.back().p_WB = Eigen::Vector3d(goal.x(), goal.y(), config.flight_height_m);
+  }
+  return out;
+}
+
+}  // namespace tgnav::harness

@@ -1,0 +1,79 @@
+#pragma once
+// Look, then fly (trial.look_then_fly; online trials, the perception-aware planners): where the
+// planner's route to the goal runs into space the vehicle has not observed, it does not fly
+// toward it looking ahead (that view, into space not yet mapped, is the one the VO lost on the
+// premise scenes, storage and gallery: docs/results/route_oracle). Instead it flies, through
+// observed free space only, to the place and yaw from which a view that the perception model
+// rates trackable on the map so far observes most of the unknown way on, every view on the way
+// rated trackable as well, and stops there; the next plan, on the map that view has grown, goes on.
+//
+// The search is over (cell, yaw) on a grid at the flight height, as scripts/route_oracle.py's
+// `explore` is on the true layout: a move keeps its yaw and goes to a neighbouring cell, a turn
+// stays and changes the yaw by one step; both end in a view the rater rates trackable.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "harness/run/look_ahead.h"
+#include "harness/run/view_guard.h"
+#include "planner/pose4.h"
+#include "planner/voxel_map.h"
+
+namespace tgnav::harness {
+
+struct LookConfig {
+  double cell_m = 0.2;                      // the search's grid (two voxels)
+  double yaw_step_rad = 15.0 * M_PI / 180;  // between the yaws it may hold
+  double robot_radius_m = 0.38;             // a cell keeps this and a voxel from occupied space ...
+  double known_m = 0.38;                    // ... and this from unknown space (online: the robot radius)
+  double flight_height_m = 1.0;
+  double half_hfov_rad = 0.656;  // a view observes within this of its axis ...
+  double observe_range_m = 6.0;  // ... this far (the online mapper's range)
+  double turn_m_per_rad = 1.67;  // a turn's cost in metres (nominal speed / nominal yaw rate)
+  double max_cost_m = 12.0;      // the search goes no farther
+  // A visited place counts as observed within this of it, for where the vehicle may go (the forward
+  // camera never sees its own place; online, stopBeforeUnknown's clear_m). For lines of sight only
+  // the disc of the robot radius does: at 0.58 m a panel 0.5 m from a visited place, never seen,
+  // let views across it rate trackable, and the VO was lost behind it (development scene detour-5002).
+  double visited_clear_m = 0.58;
+  // The way on is watched within this of its points (stopBeforeUnknown's clear_m).
+  double way_clear_m = 0.58;
+  // A look pose within this of one already flown to (and within one yaw step) is not chosen again.
+  double repeat_m = 0.3;
+  // Near where the tracking guard tripped (trial.guard_tracking), the views it turned toward are
+  // not trackable, whatever the model rates them: within this of the place, the yaws from halfway
+  // between the last good yaw and the one that tripped it on, in the turn's direction, to
+  // half_hfov_rad beyond it (where a view no longer shares any bearing with the tripped one).
+  double tripped_m = 0.5;
+};
+
+struct LookPlan {
+  // From the start (as given) to the look pose: cell centres at the flight height, unwrapped yaws;
+  // empty where no view observes anything unknown.
+  std::vector<planner::Pose4> path;
+  int seen = 0;       // unknown cells (voxel columns) the look pose's view observes
+  bool way = false;   // ... of the way on (else: of any unknown space)
+  bool goal = false;  // the path ends at the goal instead (the search reached its cell)
+  double cost_m = 0.0;
+  int states = 0;  // (cell, yaw) states the search settled
+  int cells = 0;   // cells it rated views in
+};
+
+// The search on `voxels` (the plan's voxel map; its `observed` decides what is unknown), views
+// rated by `rater` (moved about by the search) with only the landmarks whose line of sight crosses
+// observed columns. Where it reaches the cell of `goal`, the path ends there (at the goal itself).
+// Else: `way_on` is the planner's route beyond where it first runs into unknown space; `visited`,
+// places the vehicle has been; `looked`, look poses flown to before. Among the states it reaches
+// whose view observes unknown cells of the way on (or, where none does, any unknown cells), it
+// takes the nearest (by the cost of moves and turns) of those that observe at least half as many
+// as the best; ties go to more seen, then the first settled.
+LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
+                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& way_on,
+                  const std::vector<Eigen::Vector3d>& visited, const std::vector<planner::Pose4>& looked,
+                  const std::vector<GuardEvent>& tripped, const LookConfig& config);
+
+// Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
+// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it.
+bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m, double beyond_rad);
+
+}  // namespace tgnav::harness
