@@ -140,7 +140,9 @@ struct OnlineConfig {
   // trackable on the map so far (and expecting at least guard_inliers detections), to the place and
   // yaw whose trackable view observes most of the unknown way on, and stops there; the next plan goes
   // on from what it saw. Where that search reaches the goal, its way there is flown. agnostic ignores
-  // it (it has no perception model).
+  // it (it has no perception model). Measured and left off: it kept the VO for minutes, but as
+  // frozen it reached the goal on none of the development or premise scenes it flew
+  // (docs/results/look_then_fly).
   bool look_then_fly = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as

@@ -19,15 +19,9 @@ namespace tgnav::harness {
 
 namespace {
 
-// Consecutive failed plans after which a vehicle holding without a route stops (`no_path`).
-constexpr int kMaxFailedPlans = 3;
 // How far ahead (trajectory time) a new occupied voxel near the path asks for a plan.
 constexpr double kBlockedHorizonS = 10.0;
 constexpr double kBlockedStepS = 0.1;
-// A new plan whose every position lies this close (horizontally) to the current trajectory ahead
-// follows the current route: it is not flown (a switch starts from rest). Yaw is not compared:
-// where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
-constexpr double kSameRouteM = 0.75;
 
 MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const OnlineConfig& online) {
   MapBuildConfig config;
@@ -37,16 +31,6 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const OnlineCo
 }
 
 }  // namespace
-
-struct OnlinePlanning::Attempt {
-  OnlinePlan record;
-  PlanRun run;
-  std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
-  std::optional<control::SetpointTrajectory> raw;         // the planner's
-  std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
-  bool stops_short = false;            // its trajectory ends before the path does (stop_before_unknown)
-  std::optional<planner::Pose4> look;  // trial.look_then_fly: its trajectory ends at this look pose
-};
 
 OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureMap& survey,
                                planner::PlannerKind planner, std::uint64_t seed, int rrt_samples, bool external)
@@ -153,34 +137,36 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
     a.map = std::move(built.map);
     return a;
   }
-  if (cfg_.stop_before_unknown && !external_) {
-    // Observed: the robot radius and two voxels around the path (as the free places of `blocked`).
-    StopRule rule;
-    rule.clear_m = clear_m;
-    rule.half_fov_rad = lookAheadHalfFov(scenario_.planner.perception);
-    std::vector<planner::Pose4> part = stopBeforeUnknown(a.run.plan.path, built.map, visited_, rule);
-    if (part.size() < a.run.plan.path.size()) {
-      // The path flown from here on (the record keeps the plan's whole path).
-      a.run.plan.path = std::move(part);
-      a.stops_short = true;
-      if (a.run.plan.path.size() < 2) {  // nowhere to go yet: turn where it is to see the way on
-        a.raw = holdTrajectory(a.run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s, rate_hz);
-      } else {
-        smoothPath(from_here, a.run.plan.path, nullptr, &a.run);
-        a.record.trajectory_s += a.run.trajectory_s;
-        if (!a.run.trajectory.trajectory) {
-          a.record.ok = false;
-          a.record.detail = "trajectory generation failed: " + a.run.trajectory.reason;
-          return a;
-        }
-        a.raw = setpoints(a.run, rate_hz);
-      }
-    }
-  }
+  if (cfg_.stop_before_unknown && !external_ && !stopShort(from_here, built.map, clear_m, &a)) return a;
   // An external planner's yaw is its own: the look-ahead rule is the built-in planners'.
   a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map, *a.run.voxels);
   a.map = std::move(built.map);
   return a;
+}
+
+bool OnlinePlanning::stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a) {
+  // Observed: the robot radius and two voxels around the path (as the free places of `blocked`).
+  StopRule rule;
+  rule.clear_m = clear_m;
+  rule.half_fov_rad = lookAheadHalfFov(scenario_.planner.perception);
+  std::vector<planner::Pose4> part = stopBeforeUnknown(a->run.plan.path, map, visited_, rule);
+  if (part.size() >= a->run.plan.path.size()) return true;
+  // The path flown from here on (the record keeps the plan's whole path).
+  a->run.plan.path = std::move(part);
+  a->stops_short = true;
+  if (a->run.plan.path.size() < 2) {  // nowhere to go yet: turn where it is to see the way on
+    a->raw = holdTrajectory(a->run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s, holdRate());
+    return true;
+  }
+  smoothPath(from_here, a->run.plan.path, nullptr, &a->run);
+  a->record.trajectory_s += a->run.trajectory_s;
+  if (!a->run.trajectory.trajectory) {
+    a->record.ok = false;
+    a->record.detail = "trajectory generation failed: " + a->run.trajectory.reason;
+    return false;
+  }
+  a->raw = setpoints(a->run, holdRate());
+  return true;
 }
 
 bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a) {
@@ -364,57 +350,6 @@ std::vector<Eigen::Vector3d> OnlinePlanning::positionsAhead(double tau_from) con
   return ahead;
 }
 
-namespace {
-
-// Whether every pose of `path` lies within kSameRouteM (horizontally) of some point of `ahead`.
-bool followsRoute(const std::vector<planner::Pose4>& path, const std::vector<Eigen::Vector3d>& ahead) {
-  for (const planner::Pose4& pose : path) {
-    double best = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3d& p : ahead) best = std::min(best, (p - pose.p_WB).head<2>().norm());
-    if (best > kSameRouteM) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
-bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
-  return plan.chosen_blind_m >= 0.0 && plan.route_blind_m >= 0.0 &&
-         plan.chosen_blind_m + tolerance_m < plan.route_blind_m;
-}
-
-bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin) {
-  if (plan.route_blind_m < 0.0 || plan.chosen_blind_m < 0.0) return true;
-  return leavesBlindRoute(plan, blind_tolerance_m) || plan.route_length_m > (1.0 + margin) * plan.chosen_length_m;
-}
-
-void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a) {
-  const planner::Plan& plan = a->run.plan;
-  if (plan.chosen < 0 || plan.chosen >= static_cast<int>(plan.candidates.size())) return;
-  const planner::CandidatePath& chosen = plan.candidates[static_cast<std::size_t>(plan.chosen)];
-  a->record.chosen_blind_m = chosen.blind_length_m;
-  a->record.chosen_length_m = chosen.length_m;
-  for (const planner::CandidatePath& c : plan.candidates) {
-    if (c.feasible && !c.path.empty() && followsRoute(c.path, ahead)) {
-      a->record.route_blind_m = c.blind_length_m;
-      a->record.route_length_m = c.length_m;
-      return;
-    }
-  }
-}
-
-void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
-  const std::optional<control::SetpointTrajectory> renewed =
-      renewedViews(*current_, *a.raw, tau_switch, scenario_.planner.trajectory.max_yaw_rate_rad_s);
-  if (renewed) switchTo(a.look ? *renewed : lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
-}
-
-void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
-  current_ = std::make_unique<control::SetpointTrajectory>(
-      limitYawRate(control::spliceTrajectory(*current_, next, tau_switch, blend_s), tau_switch,
-                   scenario_.planner.trajectory.max_yaw_rate_rad_s));
-}
-
 void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double trajectory_start_s) {
   const auto t0 = std::chrono::steady_clock::now();
   mapper_.insertDepth(frame, cfg_.map_stride_px);
@@ -426,115 +361,6 @@ void OnlinePlanning::mapFrame(const RgbdFrame& frame, double t_s, double traject
     goal_event_ = goal_seen_;
   }
   result_.map_update_s += secondsSince(t0);
-}
-
-void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame) {
-  if (!guard_ || t_s < trajectory_start_s) return;
-  const Eigen::Isometry3d& X_WC = frame.X_WC;
-  const int inliers = frame.inliers;
-  const Eigen::Vector3d axis = X_WC.linear().col(2);  // the optical axis
-  const double yaw = std::atan2(axis.y(), axis.x());
-  const double good = guard_->goodYaw();
-  const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers, &frame.inlier_columns);
-  if (!wedge) return;
-  wedges_.push_back(*wedge);
-  result_.guards.push_back(GuardEvent{t_s, yaw, good, inliers, *wedge});
-  const double tau_now = tau(t_s, trajectory_start_s);
-  const planner::Pose4 hold{current_->sample(tau_now).p_WB, good};
-  // A reflex, not a plan: it stops within kGuardBlendS (a deceleration of about 1.3 m/s^2 at 0.4 m/s).
-  constexpr double kGuardBlendS = 0.3;
-  switchTo(holdTrajectory(hold, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_now, kGuardBlendS);
-  holding_ = true;
-  stops_short_ = false;
-  blind_view_ = true;
-  pending_until_s_ = t_s;
-}
-
-std::string OnlinePlanning::takeTrigger() {
-  const char* why = blind_view_ ? "blind_view" : blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period";
-  blind_view_ = blocked_ = goal_event_ = false;
-  return why;
-}
-
-std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
-  if (!planner_failure_.empty()) return planner_failure_;
-  const bool event = blocked_ || goal_event_ || blind_view_;
-  if (t_s < pending_until_s_ - 1e-9 || (t_s < next_replan_s_ - 1e-9 && !event)) return std::string();
-  const planner::Pose4& goal = scenario_.scene.goal;
-  const double t_eff = t_s + cfg_.plan_latency_s;
-  const bool before_start = t_eff <= trajectory_start_s;
-  planner::Pose4 start = scenario_.scene.start;
-  double tau_switch = tau0_;
-  if (!before_start) {
-    tau_switch = tau(t_eff, trajectory_start_s);
-    const control::TrajectorySetpoint sp = current_->sample(tau_switch);
-    start.p_WB = Eigen::Vector3d(sp.p_WB.x(), sp.p_WB.y(), scenario_.scene.start.p_WB.z());
-    start.yaw_rad = sp.yaw_rad;
-  }
-  const bool arriving = (start.p_WB - goal.p_WB).head<2>().norm() <= 0.5 * scenario_.trial.goal_radius_m;
-  if (arriving && failed_in_a_row_ == 0) {
-    next_replan_s_ = std::numeric_limits<double>::infinity();  // the current trajectory ends at the goal
-    takeTrigger();
-    return std::string();
-  }
-  Attempt a = planClearOf(start, t_s, takeTrigger());
-  next_replan_s_ = t_s + cfg_.replan_period_s;
-  // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
-  // to this one.
-  const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
-  const bool in_flight = a.trajectory && !before_start;  // its paths are compared with the route ahead
-  const std::vector<Eigen::Vector3d> ahead = in_flight ? positionsAhead(tau_switch) : std::vector<Eigen::Vector3d>{};
-  if (in_flight) rateRouteBlindness(ahead, &a);
-  // A plan that rates the current route blind for longer than its choice leaves it at once.
-  const bool leave_blind = cfg_.leave_blind_route && leavesBlindRoute(a.record, blindTolerance());
-  const bool must_switch = holding_ || stopping || a.record.trigger == "blocked" || leave_blind;
-  // (A plan exactly commit_s after the last change is not committed, whatever the rounding.)
-  const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
-  // Whether the plan follows the current route: asked only where it decides something.
-  // Renewing the views is the built-in planners' (as the look-ahead): an external planner's yaw is its own.
-  const bool renew = cfg_.renew_views && !external_;
-  const bool same = in_flight && !must_switch && (!committed || renew) && followsRoute(a.run.plan.path, ahead);
-  const bool keep = cfg_.keep_route && in_flight && !worthLeavingRoute(a.record, blindTolerance(), cfg_.route_margin);
-  if (a.trajectory && !must_switch && (committed || same || keep)) {
-    failed_in_a_row_ = 0;
-    if (renew && same) {
-      renewViews(a, tau_switch);
-      a.record.views_renewed = true;
-      pending_until_s_ = t_eff;
-    }
-    result_.plans.push_back(std::move(a.record));
-    return std::string();
-  }
-  if (a.trajectory) {
-    a.record.adopted = true;
-    stops_short_ = a.stops_short;
-    if (a.look) looked_.push_back(*a.look);
-    last_change_s_ = t_s;
-    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
-    pending_until_s_ = t_eff;
-    failed_in_a_row_ = 0;
-    holding_ = false;
-    if (guard_) guard_->rearm();
-    result_.plans.push_back(std::move(a.record));
-    return std::string();
-  }
-  result_.plans.push_back(a.record);
-  ++failed_in_a_row_;
-  const double tau_now = tau(t_s, trajectory_start_s);
-  const bool spent = tau_now >= current_->endTime() - cfg_.plan_latency_s;
-  if (failed_in_a_row_ >= kMaxFailedPlans && (spent || holding_)) {
-    std::ostringstream why;
-    why << failed_in_a_row_ << " plans in a row found no route (last: " << a.record.detail << ")";
-    return why.str();
-  }
-  if (spent || blockedAhead(tau_now)) {
-    // Stop where the current trajectory is at the switch, and wait for a route.
-    switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_switch,
-             before_start ? 0.0 : cfg_.blend_s);
-    holding_ = true;
-    pending_until_s_ = t_eff;
-  }
-  return std::string();
 }
 
 OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,

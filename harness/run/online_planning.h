@@ -169,6 +169,9 @@ class OnlinePlanning {
   // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
   // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
   bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
+  // trial.stop_before_unknown: a's path (and trajectory) end before they run into unknown space;
+  // false where that trajectory cannot be made (a->record says why).
+  bool stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
   void makeGuard(const Intrinsics& camera);  // trial.guard_tracking's guard, its lead with `camera`
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;
@@ -215,6 +218,17 @@ class OnlinePlanning {
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
   OnlineResult result_;
+};
+
+// One plan being made (online_planning.cpp) and decided on (online_replan.cpp).
+struct OnlinePlanning::Attempt {
+  OnlinePlan record;
+  PlanRun run;
+  std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
+  std::optional<control::SetpointTrajectory> raw;         // the planner's
+  std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
+  bool stops_short = false;            // its trajectory ends before the path does (stop_before_unknown)
+  std::optional<planner::Pose4> look;  // trial.look_then_fly: its trajectory ends at this look pose
 };
 
 }  // namespace tgnav::harness
