@@ -29,12 +29,12 @@ struct LookConfig {
   double flight_height_m = 1.0;
   double half_hfov_rad = 0.656;  // a view observes within this of its axis ...
   double observe_range_m = 6.0;  // ... this far (the online mapper's range)
-  double turn_m_per_rad = 1.67;  // a turn's cost in metres (nominal speed / nominal yaw rate)
+  double turn_m_per_rad = 1.67;  // a turn's cost in metres per radian (online: nominal speed / yaw rate)
   double max_cost_m = 12.0;      // the search goes no farther
   // A visited place counts as observed within this of it, for where the vehicle may go (the forward
   // camera never sees its own place; online, stopBeforeUnknown's clear_m). For lines of sight only
-  // the disc of the robot radius does: at 0.58 m a panel 0.5 m from a visited place, never seen,
-  // let views across it rate trackable, and the VO was lost behind it (development scene detour-5002).
+  // the disc of the robot radius does: beyond the disc its body covered, a surface never seen may
+  // stand.
   double visited_clear_m = 0.58;
   // The way on is watched within this of its points (stopBeforeUnknown's clear_m).
   double way_clear_m = 0.58;
