@@ -158,11 +158,15 @@ bool OnlinePlanning::stopShort(const Scenario& from_here, const planner::Feature
     a->raw = holdTrajectory(a->run.plan.path.front(), cfg_.replan_period_s + cfg_.plan_latency_s, holdRate());
     return true;
   }
+  return smoothInto(from_here, "", a);
+}
+
+bool OnlinePlanning::smoothInto(const Scenario& from_here, const std::string& detail_prefix, Attempt* a) {
   smoothPath(from_here, a->run.plan.path, nullptr, &a->run);
   a->record.trajectory_s += a->run.trajectory_s;
   if (!a->run.trajectory.trajectory) {
     a->record.ok = false;
-    a->record.detail = "trajectory generation failed: " + a->run.trajectory.reason;
+    a->record.detail = detail_prefix + "trajectory generation failed: " + a->run.trajectory.reason;
     return false;
   }
   a->raw = setpoints(a->run, holdRate());
@@ -209,14 +213,7 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
     return true;
   }
   a->run.plan.path = found.path;
-  smoothPath(from_here, a->run.plan.path, nullptr, &a->run);
-  a->record.trajectory_s += a->run.trajectory_s;
-  if (!a->run.trajectory.trajectory) {
-    a->record.ok = false;
-    a->record.detail = "look_then_fly: trajectory generation failed: " + a->run.trajectory.reason;
-    return true;
-  }
-  a->raw = setpoints(a->run, scenario_.planner.trajectory.sample_rate_hz);
+  if (!smoothInto(from_here, "look_then_fly: ", a)) return true;
   a->stops_short = !found.goal;
   if (!found.goal) a->look = found.path.back();
   return true;

@@ -172,6 +172,9 @@ class OnlinePlanning {
   // trial.stop_before_unknown: a's path (and trajectory) end before they run into unknown space;
   // false where that trajectory cannot be made (a->record says why).
   bool stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
+  // a's trajectory: its path smoothed, into setpoints (a->raw); false, with a->record's detail after
+  // `detail_prefix`, where the trajectory cannot be made.
+  bool smoothInto(const Scenario& from_here, const std::string& detail_prefix, Attempt* a);
   void makeGuard(const Intrinsics& camera);  // trial.guard_tracking's guard, its lead with `camera`
   bool askExternal(const Scenario& from_here, const planner::FeatureMap& map, Attempt* a);
   bool blockedAhead(double tau_from) const;

@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "planner/feature_map.h"
+#include "tests/harness/test_util.h"
 
 namespace tgnav::harness {
 namespace {
@@ -16,40 +17,11 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kHeight = 1.0;
 
-// A textured wall facing west at x = 3.5 (y in [-1.5, 1], z in [0.5, 1.5]), two landmarks on each
-// voxel of its face, each detected whenever in view; free space observed for x in [0, observed_to)
-// and y in [-1.5, 1) over the same heights; everything else unknown.
-planner::FeatureMap wallRoom(double observed_to, bool landmarks = true) {
-  planner::FeatureMap map(0.1);
-  for (double x = 0.05; x < observed_to; x += 0.1) {
-    for (double y = -1.45; y < 1.0; y += 0.1) {
-      for (double z = 0.55; z < 1.5; z += 0.1) {
-        map.occupancy().updateNode(
-            octomap::point3d(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)), false);
-      }
-    }
-  }
-  std::vector<planner::Landmark> seen;
-  for (double y = -1.45; y < 1.0; y += 0.1) {
-    for (double z = 0.55; z < 1.5; z += 0.1) {
-      map.occupancy().updateNode(octomap::point3d(3.55F, static_cast<float>(y), static_cast<float>(z)), true);
-      for (double dz : {-0.02, 0.02}) {
-        planner::Landmark lm;
-        lm.p_W = Eigen::Vector3d(3.5, y, z + dz);
-        lm.observations = lm.opportunities = 1;
-        lm.ref_kf_p_W = Eigen::Vector3d(0.0, y, z);
-        seen.push_back(lm);
-      }
-    }
-  }
-  if (landmarks) map.setLandmarks(seen);
-  EXPECT_EQ(map.embedLandmarks(0.15), 0);
-  return map;
-}
-
-// The map as the planners' voxel map (unknown space free, as online), and a rater on it.
+// The map (test::texturedWall(): the wall at x = 3.5, free space observed for x in [0, observed_to),
+// everything else unknown) as the planners' voxel map (unknown space free, as online), and a rater
+// on it.
 struct Room {
-  explicit Room(double observed_to, bool landmarks = true) : map(wallRoom(observed_to, landmarks)) {}
+  explicit Room(double observed_to, bool landmarks = true) : map(test::texturedWall(observed_to, landmarks)) {}
   planner::FeatureMap map;
   planner::VoxelMap voxels{map, Eigen::Vector3d(-0.5, -2.5, 0), Eigen::Vector3d(4.5, 4.5, 2), 0.3, 1.7, true};
   planner::VisibilityConfig visibility;

@@ -18,6 +18,7 @@
 #include "planner/feature_map.h"
 #include "planner/perception.h"
 #include "planner/voxel_map.h"
+#include "tests/harness/test_util.h"
 
 namespace tgnav::harness {
 namespace {
@@ -108,34 +109,12 @@ TEST(RenewedViews, KeepTheVehiclesYawAtTheSwitchAndTurnToThePlansWithinTheLimit)
   EXPECT_FALSE(renewedViews(current, plan, 9.995, 0.6).has_value());
 }
 
-// A textured wall facing west at x = 3.5 (y in [-1.5, 1], z in [0.5, 1.5]), two landmarks on each
-// voxel of its face, each detected whenever in view; nothing else is known.
-planner::FeatureMap texturedWall() {
-  planner::FeatureMap map(0.1);
-  std::vector<planner::Landmark> landmarks;
-  for (double y = -1.45; y < 1.0; y += 0.1) {
-    for (double z = 0.55; z < 1.5; z += 0.1) {
-      map.occupancy().updateNode(octomap::point3d(3.55F, static_cast<float>(y), static_cast<float>(z)), true);
-      for (double dz : {-0.02, 0.02}) {
-        planner::Landmark lm;
-        lm.p_W = Eigen::Vector3d(3.5, y, z + dz);
-        lm.observations = lm.opportunities = 1;
-        lm.ref_kf_p_W = Eigen::Vector3d(0.0, y, z);
-        landmarks.push_back(lm);
-      }
-    }
-  }
-  map.setLandmarks(landmarks);
-  EXPECT_EQ(map.embedLandmarks(0.15), 0);
-  return map;
-}
-
 constexpr double kDeg = M_PI / 180.0;
 
-// texturedWall() as the planners' voxel map (unknown space free), and a rater of views on it (the
-// gates: 50 detections, a fifth of the image).
+// test::texturedWall() (nothing known but the wall) as the planners' voxel map (unknown space
+// free), and a rater of views on it (the gates: 50 detections, a fifth of the image).
 struct WallViews {
-  planner::FeatureMap map = texturedWall();
+  planner::FeatureMap map = test::texturedWall();
   planner::VoxelMap voxels{map, Eigen::Vector3d(-1, -3, 0), Eigen::Vector3d(5, 5, 2), 0.5, 1.5, true};
   planner::VisibilityConfig visibility;
   planner::InformationConfig information;

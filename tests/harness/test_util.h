@@ -9,6 +9,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "harness/base/errors.h"
 #include "harness/base/quiet_stderr.h"
@@ -83,6 +84,37 @@ inline planner::FeatureMap sceneMap(const std::string& name) {
   const harness::CachedMap cached = harness::cachedFeatureMap(scene, harness::MapBuildConfig{}, TGNAV_TEST_CACHE);
   const harness::QuietStderr quiet;
   return planner::FeatureMap::load(cached.dir);
+}
+
+// A textured wall 3.55 m east of the origin (y -1.45 to 1.0 m, z 0.55 to 1.5 m; 0.1 m voxels), two
+// landmarks per voxel on its face unless `landmarks` is false, the space from x = 0 to `free_to`
+// observed free in front of it.
+inline planner::FeatureMap texturedWall(double free_to = 0.0, bool landmarks = true) {
+  planner::FeatureMap map(0.1);
+  for (double x = 0.05; x < free_to; x += 0.1) {
+    for (double y = -1.45; y < 1.0; y += 0.1) {
+      for (double z = 0.55; z < 1.5; z += 0.1) {
+        map.occupancy().updateNode(
+            octomap::point3d(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z)), false);
+      }
+    }
+  }
+  std::vector<planner::Landmark> seen;
+  for (double y = -1.45; y < 1.0; y += 0.1) {
+    for (double z = 0.55; z < 1.5; z += 0.1) {
+      map.occupancy().updateNode(octomap::point3d(3.55F, static_cast<float>(y), static_cast<float>(z)), true);
+      for (double dz : {-0.02, 0.02}) {
+        planner::Landmark lm;
+        lm.p_W = Eigen::Vector3d(3.5, y, z + dz);
+        lm.observations = lm.opportunities = 1;
+        lm.ref_kf_p_W = Eigen::Vector3d(0.0, y, z);
+        seen.push_back(lm);
+      }
+    }
+  }
+  if (landmarks) map.setLandmarks(seen);
+  EXPECT_EQ(map.embedLandmarks(0.15), 0);
+  return map;
 }
 
 }  // namespace tgnav::test
