@@ -45,6 +45,12 @@ struct VisibilityConfig {
   // (cameraPosition()). 0: from the body's centre, as the paper.
   double camera_forward_m = 0.0;
   double camera_up_m = 0.0;
+  // How a landmark's voxel is seen (ours). false, the paper's occlusion test: the segment from the
+  // camera to the voxel's centre meets no occupied voxel before it. true: the segment to the free
+  // voxel in front of the voxel's face toward the camera meets none (VoxelMap::lineOfSightToFace):
+  // the landmark lies on that face, and the first test hides a wall's landmarks seen within about
+  // 45 deg of the wall's plane behind the wall's own next voxel.
+  bool sight_to_face = false;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -55,6 +61,7 @@ struct VisibilityConfig {
     a("max_range_m", max_range_m);
     a("camera_forward_m", camera_forward_m);
     a("camera_up_m", camera_up_m);
+    a("sight_to_face", sight_to_face);
   }
 
   void validate() const;

@@ -199,7 +199,7 @@ class CovisibilityScorer {
       const Eigen::Vector3d d = all[slot].centre_W - p;
       const double r = d.norm();
       if (r < vis.min_range_m || r > vis.max_range_m || std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
-      if (voxels_.lineOfSight(p, all[slot].index)) v.slots.push_back(static_cast<int>(slot));
+      if (voxels_.sees(p, all[slot].index, vis)) v.slots.push_back(static_cast<int>(slot));
     }
     return cache_.emplace(key, std::move(v)).first->second;
   }

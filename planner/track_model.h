@@ -63,6 +63,7 @@ struct TrackModel {
     double min_range_m = 0.0;
     double max_range_m = 0.0;
     double max_incidence_rad = 0.0;
+    double sight_to_face = 0.0;  // 1: VisibilityConfig::sight_to_face (absent from older files: 0)
   };
   bool has_view_settings = false;
   ViewSettings view_settings;

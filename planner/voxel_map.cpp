@@ -190,6 +190,27 @@ bool VoxelMap::lineOfSightWalked(const Eigen::Vector3d& p_W, int index) const {
   return false;  // numerical miss of the target voxel: treat as not seen
 }
 
+bool VoxelMap::lineOfSightToFace(const Eigen::Vector3d& p_W, int index) const {
+  const Eigen::Vector3i c(index % size_.x(), (index / size_.x()) % size_.y(), index / (size_.x() * size_.y()));
+  const Eigen::Vector3d to_p = p_W - centreOf(index);
+  int best = -1;
+  double best_lead = 0.5 * res_;  // p beyond the face's plane
+  for (int axis = 0; axis < 3; ++axis) {
+    for (const int side : {-1, 1}) {
+      const double lead = side * to_p[axis];
+      if (lead <= best_lead) continue;
+      Eigen::Vector3i n = c;
+      n[axis] += side;
+      if (!inside(n)) continue;
+      const int beyond = flat(n.x(), n.y(), n.z());
+      if (state_[static_cast<std::size_t>(beyond)] == VoxelState::kOccupied) continue;
+      best = beyond;
+      best_lead = lead;
+    }
+  }
+  return best >= 0 && lineOfSight(p_W, best);
+}
+
 namespace {
 
 // Calls visit(slot) for each landmark voxel within range and the vertical FoV of p that `keep`
@@ -208,7 +229,7 @@ void forVisibleVoxels(const VoxelMap& map, const Eigen::Vector3d& p_W, const Vis
     if (r2 < min2 || r2 > max2) continue;
     if (std::abs(d.z()) > tan_half_vfov * d.head<2>().norm()) continue;
     if (keep && !keep(v)) continue;
-    if (!map.lineOfSight(p_W, v.index)) continue;
+    if (!map.sees(p_W, v.index, config)) continue;
     visit(slot);
   }
 }

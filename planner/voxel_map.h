@@ -76,6 +76,17 @@ class VoxelMap {
   // The same by walking every voxel from p (lineOfSight first looks at the voxel the segment
   // enters the target from, which answers most blocked rays at once): the reference for tests.
   bool lineOfSightWalked(const Eigen::Vector3d& p_W, int index) const;
+  // Whether p sees the face of voxel `index` that looks most toward it: the first occupied voxel
+  // from p towards the centre of the voxel beyond that face (not occupied; the faces whose plane p
+  // lies beyond, and whose voxel beyond is inside the box) is none. A landmark lies on its
+  // surface's face, not at its voxel's centre: a segment to the centre of a wall's voxel seen
+  // within about 45 deg of the wall's plane runs through the wall's next voxel first, and
+  // lineOfSight() rates that landmark hidden by its own wall (VisibilityConfig::sight_to_face).
+  bool lineOfSightToFace(const Eigen::Vector3d& p_W, int index) const;
+  // lineOfSightToFace() where config.sight_to_face, else lineOfSight().
+  bool sees(const Eigen::Vector3d& p_W, int index, const VisibilityConfig& config) const {
+    return config.sight_to_face ? lineOfSightToFace(p_W, index) : lineOfSight(p_W, index);
+  }
 
   // Distance from p to the nearest obstacle voxel's cube (0 inside one, outside the box or the
   // clearance band).

@@ -125,7 +125,9 @@ def read_views(folder, views, vo_header, vo_rows):
     return out_header, out, settings
 
 
-VIEW_SETTINGS = ["hfov_rad", "vfov_rad", "min_range_m", "max_range_m", "max_incidence_rad"]
+VIEW_SETTINGS = ["hfov_rad", "vfov_rad", "min_range_m", "max_range_m", "max_incidence_rad", "sight_to_face"]
+# Settings that files from before them lack: absent, they had this value.
+VIEW_SETTING_DEFAULTS = {"sight_to_face": 0.0}
 
 
 def parse_view_settings(path, line):
@@ -137,6 +139,7 @@ def parse_view_settings(path, line):
         settings = {k: float(v) for k, v in (item.split("=") for item in line[len(prefix):].split())}
     except ValueError:
         raise InputError(f"{path}: the first line '{line.strip()}' does not parse")
+    settings = {**VIEW_SETTING_DEFAULTS, **settings}
     missing = [k for k in VIEW_SETTINGS if k not in settings]
     if missing:
         raise InputError(f"{path}: the first line has no {missing[0]}")
@@ -149,6 +152,7 @@ def config_view_settings(config, folder):
     info = (config.get("planner") or {}).get("information") or {}
     values = {k: vis.get(k) for k in VIEW_SETTINGS[:4]}
     values["max_incidence_rad"] = info.get("max_incidence_rad")
+    values["sight_to_face"] = 1.0 if vis.get("sight_to_face", False) is True else 0.0
     missing = [k for k, v in values.items() if v is None]
     if missing:
         raise InputError(f"{os.path.join(folder, 'config.yaml')}: no planner setting {missing[0]} (the view settings "
@@ -467,7 +471,8 @@ def cmd_evaluate(args):
     with open(args.model) as f:
         fitted = json.load(f).get("view_settings")
     for tr in all_trials if fitted else []:
-        if tr["view_settings"] != {k: float(fitted.get(k, float("nan"))) for k in VIEW_SETTINGS}:
+        if tr["view_settings"] != {k: float(fitted.get(k, VIEW_SETTING_DEFAULTS.get(k, float("nan"))))
+                                   for k in VIEW_SETTINGS}:
             raise InputError(f"{tr['folder']}: its features were counted with {tr['view_settings']}, the model "
                              f"{args.model} with {fitted} (--views: features computed again with the model's settings)")
     trials = [dict(tr, x=design(tr["x"], terms)) for tr in select(all_trials, names)]

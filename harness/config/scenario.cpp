@@ -145,7 +145,8 @@ void checkViewSettings(const planner::TrackModel& model, const planner::Percepti
       {"planner.visibility.vfov_rad", fitted.vfov_rad, perception.visibility.vfov_rad},
       {"planner.visibility.min_range_m", fitted.min_range_m, perception.visibility.min_range_m},
       {"planner.visibility.max_range_m", fitted.max_range_m, perception.visibility.max_range_m},
-      {"planner.information.max_incidence_rad", fitted.max_incidence_rad, perception.information.max_incidence_rad}};
+      {"planner.information.max_incidence_rad", fitted.max_incidence_rad, perception.information.max_incidence_rad},
+      {"planner.visibility.sight_to_face", fitted.sight_to_face, perception.visibility.sight_to_face ? 1.0 : 0.0}};
   for (const auto& [key, model_value, config_value] : pairs) {
     if (std::abs(model_value - config_value) <= 1e-9 * std::max(1.0, std::abs(model_value))) continue;
     std::ostringstream msg;

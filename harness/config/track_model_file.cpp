@@ -75,6 +75,14 @@ void readViewSettings(const std::filesystem::path& file, const Json& doc, planne
       if (!settings->contains(key)) fail(file, "key '" + name + "' is missing");
       *value = number(file, (*settings)[key], name);
     }
+    // Optional (files from before it counted to the voxel's centre: 0); 0 or 1.
+    if (settings->contains("sight_to_face")) {
+      const Json& face = (*settings)["sight_to_face"];
+      v.sight_to_face = number(file, face, "view_settings.sight_to_face");
+      if (v.sight_to_face != 0.0 && v.sight_to_face != 1.0) {
+        fail(file, "key 'view_settings.sight_to_face' has value '" + face.dump() + "', expected 0 or 1");
+      }
+    }
     model->has_view_settings = true;
   }
 }

@@ -137,9 +137,10 @@ ViewsResult runViews(const ViewsJob& job) {
     char settings[256];
     std::snprintf(settings, sizeof settings,
                   "# view_settings: hfov_rad=%.17g vfov_rad=%.17g min_range_m=%.17g max_range_m=%.17g "
-                  "max_incidence_rad=%.17g\n",
+                  "max_incidence_rad=%.17g sight_to_face=%d\n",
                   model.visibility.hfov_rad, model.visibility.vfov_rad, model.visibility.min_range_m,
-                  model.visibility.max_range_m, model.information.max_incidence_rad);
+                  model.visibility.max_range_m, model.information.max_incidence_rad,
+                  model.visibility.sight_to_face ? 1 : 0);
     out << settings;
   }
   out.precision(6);

@@ -27,7 +27,7 @@ struct ViewsResult {
 };
 
 // Writes `out` (atomically): a first line "# view_settings: hfov_rad=H vfov_rad=V min_range_m=A
-// max_range_m=B max_incidence_rad=I" (what the features were computed with), then the header t
+// max_range_m=B max_incidence_rad=I sight_to_face=F" (what the features were computed with), then the header t
 // and vo.csv's predicted_* columns, one row per vo.csv row.
 // InputError naming the file for a folder that is not a finished trial, a vo.csv frame without a
 // gt.tum pose at its time, a bad --set, or an --out that exists without `force`.

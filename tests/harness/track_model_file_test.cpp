@@ -109,6 +109,10 @@ TEST(TrackModelFile, EveryMalformedFileIsOneLineNamingFileAndKey) {
        "key 'view_settings' has value '10', expected an object"},
       {with("\"intercept\": 0.25,", "\"intercept\": 0.25, \"view_settings\": {\"hfov_rad\": 1},"),
        "key 'view_settings.vfov_rad' is missing"},
+      {with("\"intercept\": 0.25,",
+            "\"intercept\": 0.25, \"view_settings\": {\"hfov_rad\": 1, \"vfov_rad\": 1, \"min_range_m\": 0.3, "
+            "\"max_range_m\": 10, \"max_incidence_rad\": 1, \"sight_to_face\": 0.5},"),
+       "key 'view_settings.sight_to_face' has value '0.5', expected 0 or 1"},
   };
   for (const auto& [text, expected] : cases) {
     const auto file = test::writeFile(dir / "bad.json", text);
@@ -180,14 +184,14 @@ TEST_F(TrackModelScenario, AMissingModelIsNamedWithItsKey) {
 // others is refused, naming the setting and both values.
 TEST_F(TrackModelScenario, AModelFittedForOtherViewSettingsIsRefused) {
   const planner::PerceptionPlannerConfig defaults;
-  const auto model = [&](double max_range_m) {
+  const auto model = [&](double max_range_m, const char* face = "") {
     std::ostringstream text;
     text.precision(17);
     text << R"({"format": "tgnav-track-model", "version": 1, "kind": "logistic", "features": ["coverage"],
       "mean": [0.2], "scale": [0.1], "weights": [1.0], "intercept": 0.0, "view_settings": {"hfov_rad": )"
          << defaults.visibility.hfov_rad << ", \"vfov_rad\": " << defaults.visibility.vfov_rad
          << ", \"min_range_m\": " << defaults.visibility.min_range_m << ", \"max_range_m\": " << max_range_m
-         << ", \"max_incidence_rad\": " << defaults.information.max_incidence_rad << "}}";
+         << ", \"max_incidence_rad\": " << defaults.information.max_incidence_rad << face << "}}";
     return text.str();
   };
   test::writeFile(dir_ / "same.json", model(defaults.visibility.max_range_m));
@@ -211,6 +215,16 @@ TEST_F(TrackModelScenario, AModelFittedForOtherViewSettingsIsRefused) {
   const YamlDoc far = YamlDoc::fromOverrides(
       {"planner.visibility.max_range_m=" + std::to_string(defaults.visibility.max_range_m + 4.0)});
   EXPECT_NE(loadScenario(file, &far).planner.perception.information.model, nullptr);
+
+  // Counted to the landmarks' faces (VisibilityConfig::sight_to_face), planned to their centres: refused.
+  test::writeFile(dir_ / "face.json", model(defaults.visibility.max_range_m, ", \"sight_to_face\": 1"));
+  const auto face_file = scenario("planner: {information: {track_model: face.json}}\n");
+  EXPECT_NE(inputError([&] {
+              loadScenario(face_file);
+            }).find("it was fitted with planner.visibility.sight_to_face = 1, this config has 0"),
+            std::string::npos);
+  const YamlDoc face = YamlDoc::fromOverrides({"planner.visibility.sight_to_face=true"});
+  EXPECT_NE(loadScenario(face_file, &face).planner.perception.information.model, nullptr);
 }
 
 }  // namespace

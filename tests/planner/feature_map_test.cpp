@@ -194,6 +194,48 @@ TEST(VoxelMapLineOfSight, AgreesWithTheWalkEverywhere) {
             << " see their voxel\n";
 }
 
+// A wall's landmarks seen along the wall: the segment to a voxel's centre runs through the wall's
+// next voxel within about 45 deg of the wall's plane (lineOfSight), the one to the free voxel in
+// front of its face does not (lineOfSightToFace). From behind the wall, neither sees them.
+TEST(VoxelMapLineOfSight, ToTheFaceSeesAWallAlongItsPlaneNotFromBehind) {
+  testing::SyntheticWorld w;
+  w.max_W = {6.0, 5.0, 2.0};
+  const Eigen::AlignedBox3d wall(Eigen::Vector3d(3.0, 0.5, 0.0), Eigen::Vector3d(3.3, 4.5, 2.0));
+  w.solids.push_back(wall);
+  w.texture(wall, Eigen::Vector3d(-1, 0, 0), 0.1);
+  const FeatureMap map = w.build();
+  const VoxelMap voxels(map, w.min_W, w.max_W);
+  const Eigen::Vector3d front(1.5, 0.6, 1.0);  // in front of the wall's south end, 1.5 m away
+  const Eigen::Vector3d behind(4.5, 2.5, 1.0);
+  int total = 0;
+  int centre = 0;
+  int face = 0;
+  int steep = 0;  // seen within 45 deg of the normal
+  for (const LandmarkVoxel& lv : voxels.landmarkVoxels()) {
+    const Eigen::Vector3d d = lv.centre_W - front;
+    if (std::abs(d.z()) > 0.5) continue;  // near the camera's height: the angle to the plane is the bearing's
+    ++total;
+    const bool by_centre = voxels.lineOfSight(front, lv.index);
+    const bool by_face = voxels.lineOfSightToFace(front, lv.index);
+    centre += by_centre;
+    face += by_face;
+    steep += std::abs(d.y()) < std::abs(d.x());
+    EXPECT_TRUE(by_face || !by_centre) << lv.centre_W.transpose();
+    EXPECT_FALSE(voxels.lineOfSightToFace(behind, lv.index)) << lv.centre_W.transpose();
+    EXPECT_FALSE(voxels.lineOfSight(behind, lv.index)) << lv.centre_W.transpose();
+  }
+  ASSERT_GT(total, 100);
+  EXPECT_EQ(face, total);
+  EXPECT_LE(centre, steep + total / 20);  // the centre's test: hardly any beyond 45 deg
+  EXPECT_LT(centre, total / 2);
+  VisibilityConfig config;
+  config.sight_to_face = true;
+  EXPECT_GE(static_cast<int>(voxels.visibleSlots(front, config).size()), face);  // these and the rest
+  std::cout << "[ figure   ] wall voxels near the camera's height seen from 1.5 m, along the wall: " << centre
+            << " to their centre, " << face << " to their face, of " << total << " (" << steep
+            << " within 45 deg of the normal)\n";
+}
+
 // An online planner may plan through space it has not observed: with unknown_free, unknown
 // voxels are free (for clearance too), observed ones keep their state.
 TEST(VoxelMapUnknownSpace, UnknownBlocksByDefaultAndIsFreeWhenAsked) {

@@ -48,7 +48,7 @@ def write_trial(folder, rng, oracle=-1, detections_scale=1.0, span_penalty=0.0):
                 "    max_incidence_rad: 1.5707963267948966\n")
 
 
-def write_views(folder, max_range_m, rows=None):
+def write_views(folder, max_range_m, rows=None, name="views.csv", face=None):
     """What `tgnav views` writes for the trial in `folder`: its settings line, then its vo.csv's
     predicted_* columns (here: the same values, counted at another range)."""
     with open(os.path.join(folder, "vo.csv")) as f:
@@ -57,9 +57,10 @@ def write_views(folder, max_range_m, rows=None):
     cols = ["t"] + [c for c in header if c.startswith("predicted_")]
     idx = [header.index(c) for c in cols]
     body = [",".join(row[i] for i in idx) for row in lines][:rows]
-    with open(os.path.join(folder, "views.csv"), "w") as f:
+    face = "" if face is None else f" sight_to_face={face}"
+    with open(os.path.join(folder, name), "w") as f:
         f.write(f"# view_settings: hfov_rad=1.3125 vfov_rad=1.0472 min_range_m=0.3 max_range_m={max_range_m} "
-                "max_incidence_rad=1.5707963267948966\n" + ",".join(cols) + "\n" + "\n".join(body) + "\n")
+                f"max_incidence_rad=1.5707963267948966{face}\n" + ",".join(cols) + "\n" + "\n".join(body) + "\n")
 
 
 def make_sweep(root, scenes, seed):
@@ -240,6 +241,7 @@ class FitTrackModel(unittest.TestCase):
         self.assertEqual(read_json(six)["view_settings"]["max_range_m"], 6.0)  # from config.yaml
         self.assertEqual(read_json(ten)["view_settings"]["max_range_m"], 10.0)  # from views.csv
         self.assertEqual(read_json(ten)["fitted_on"]["views"], "views.csv")
+        self.assertEqual(read_json(six)["view_settings"]["sight_to_face"], 0.0)  # absent: the voxel's centre
         self.assertEqual(read_json(ten)["weights"], read_json(six)["weights"])  # the same numbers here
         r = run("evaluate", held, "--model", ten, "--views", "views.csv", "--out", os.path.join(self.dir, "e10"))
         self.assertEqual(r.returncode, 0, r.stderr)
@@ -248,6 +250,18 @@ class FitTrackModel(unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("its features were counted with", r.stderr)
         self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        # counted to the landmarks' faces: the model says so, and is refused on features counted to centres
+        for root in (calib, held):
+            for t in os.listdir(os.path.join(root, "trials")):
+                write_views(os.path.join(root, "trials", t), 10, name="face.csv", face=1)
+        face = os.path.join(self.dir, "face.json")
+        self.assertEqual(run("fit", calib, "--out", face, "--views", "face.csv").returncode, 0)
+        self.assertEqual(read_json(face)["view_settings"]["sight_to_face"], 1.0)
+        self.assertEqual(run("evaluate", held, "--model", face, "--views", "face.csv",
+                             "--out", os.path.join(self.dir, "ef")).returncode, 0)
+        r = run("evaluate", held, "--model", face, "--views", "views.csv", "--out", os.path.join(self.dir, "ec"))
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("'sight_to_face': 0.0", r.stderr)
         # views of another trial (too few rows), and a missing views file
         trial = os.path.join(held, "trials", "c-1__proposed__s01")
         write_views(trial, 10, rows=50)
