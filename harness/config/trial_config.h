@@ -137,13 +137,18 @@ struct OnlineConfig {
   bool stop_before_unknown = false;
   // Look, then fly (harness/run/explore.h; proposed and rrtstar): where the plan's route runs into
   // unknown space, the vehicle flies instead, through observed free space and with every view rated
-  // trackable on the map so far (and expecting at least guard_inliers detections), to the place and
+  // trackable on the map so far (and expecting at least look_min_detections detections), to the place and
   // yaw whose trackable view observes most of the unknown way on, and stops there; the next plan goes
   // on from what it saw. Where that search reaches the goal, its way there is flown. agnostic ignores
   // it (it has no perception model). Measured and left off: it kept the VO for minutes, but as
   // frozen it reached the goal on none of the development or premise scenes it flew
   // (docs/results/look_then_fly).
   bool look_then_fly = false;
+  // The detections (planner::ViewSupport::detections) every view look_then_fly flies must expect,
+  // on top of the perception model's rating; 0: the model's alone. 150, the tracking guard's
+  // guard_inliers, chosen before any run: the model fitted with the paper's line of sight rated
+  // views trackable where the VO found 50-80 features (docs/results/look_then_fly).
+  double look_min_detections = 150.0;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
@@ -203,6 +208,7 @@ struct OnlineConfig {
     a("hold_first_plan", hold_first_plan);
     a("stop_before_unknown", stop_before_unknown);
     a("look_then_fly", look_then_fly);
+    a("look_min_detections", look_min_detections);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);

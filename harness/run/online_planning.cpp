@@ -192,11 +192,11 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
       scenario_.planner.trajectory.nominal_speed_mps / scenario_.planner.trajectory.nominal_yaw_rate_rad_s;
   look.visited_clear_m = clear_m;
   look.way_clear_m = clear_m;
-  // The views it flies must expect as many detections as the tracking guard asks of inliers (the
-  // model's probability alone rated views trackable where the VO found 50-80 features for seconds
-  // and was lost: development scene detour-5003).
+  // The views it flies must expect trial.look_min_detections detections (150 by default, what the
+  // tracking guard asks of inliers: the model fitted with the paper's line of sight alone rated views
+  // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
   ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
-  rater.setDetectionFloor(cfg_.guard_inliers);
+  if (cfg_.look_min_detections > 0.0) rater.setDetectionFloor(cfg_.look_min_detections);
   const LookPlan found = planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, way_on,
                                   visited_, looked_, result_.guards, look);
   a->record.look_cells = found.cells;
