@@ -85,10 +85,7 @@ Eigen::Vector3i VoxelMap::cellOf(const Eigen::Vector3d& p_W) const {
 }
 
 Eigen::Vector3d VoxelMap::centreOf(int index) const {
-  const int x = index % size_.x();
-  const int y = (index / size_.x()) % size_.y();
-  const int z = index / (size_.x() * size_.y());
-  return origin_ + res_ * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5);
+  return origin_ + res_ * (cellOfIndex(index).cast<double>() + Eigen::Vector3d::Constant(0.5));
 }
 
 VoxelState VoxelMap::state(const Eigen::Vector3d& p_W) const {
@@ -113,10 +110,7 @@ bool VoxelMap::lineOfSight(const Eigen::Vector3d& p_W, int index) const {
   const double lead = a.maxCoeff(&axis);
   const double second = std::max(a[(axis + 1) % 3], a[(axis + 2) % 3]);
   if (lead > res_ && second < kClearLead * lead) {  // p outside the target voxel, a clear lead
-    const int x = index % size_.x();
-    const int y = (index / size_.x()) % size_.y();
-    const int z = index / (size_.x() * size_.y());
-    Eigen::Vector3i before(x, y, z);
+    Eigen::Vector3i before = cellOfIndex(index);
     before[axis] -= d[axis] > 0.0 ? 1 : -1;
     if (inside(before) &&
         state_[static_cast<std::size_t>(flat(before.x(), before.y(), before.z()))] == VoxelState::kOccupied) {
@@ -191,7 +185,7 @@ bool VoxelMap::lineOfSightWalked(const Eigen::Vector3d& p_W, int index) const {
 }
 
 bool VoxelMap::lineOfSightToFace(const Eigen::Vector3d& p_W, int index) const {
-  const Eigen::Vector3i c(index % size_.x(), (index / size_.x()) % size_.y(), index / (size_.x() * size_.y()));
+  const Eigen::Vector3i c = cellOfIndex(index);
   const Eigen::Vector3d to_p = p_W - centreOf(index);
   int best = -1;
   double best_lead = 0.5 * res_;  // p beyond the face's plane
@@ -308,9 +302,10 @@ double VoxelMap::centreDistance(const Eigen::Vector3i& c) const {
 }
 
 Eigen::Vector3d VoxelMap::surfaceNormal(int index) const {
-  const int x = index % size_.x();
-  const int y = (index / size_.x()) % size_.y();
-  const int z = index / (size_.x() * size_.y());
+  const Eigen::Vector3i at = cellOfIndex(index);
+  const int x = at.x();
+  const int y = at.y();
+  const int z = at.z();
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   int free = 0;
   for (int dz = -2; dz <= 2; ++dz) {

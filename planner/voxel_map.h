@@ -114,6 +114,9 @@ class VoxelMap {
 
  private:
   int flat(int x, int y, int z) const { return (z * size_.y() + y) * size_.x() + x; }
+  Eigen::Vector3i cellOfIndex(int index) const {  // flat()'s inverse
+    return {index % size_.x(), (index / size_.x()) % size_.y(), index / (size_.x() * size_.y())};
+  }
   Eigen::Vector3i cellOf(const Eigen::Vector3d& p_W) const;
   bool inside(const Eigen::Vector3i& c) const { return (c.array() >= 0).all() && (c.array() < size_.array()).all(); }
   Eigen::Vector3d centreOf(int index) const;

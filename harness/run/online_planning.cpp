@@ -196,7 +196,7 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   // tracking guard asks of inliers: the model fitted with the paper's line of sight alone rated views
   // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
   ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
-  if (cfg_.look_min_detections > 0.0) rater.setDetectionFloor(cfg_.look_min_detections);
+  rater.setDetectionFloor(cfg_.look_min_detections);  // 0: none
   const LookPlan found = planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, way_on,
                                   visited_, looked_, result_.guards, look);
   a->record.look_cells = found.cells;
