@@ -203,11 +203,14 @@ void IncrementalMapper::observeFeatures(const RgbdFrame& frame) {
   views_.emplace_back(frame);
 }
 
-IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTree> tree) const {
+IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTree> tree) {
   Built out{planner::FeatureMap(std::move(tree))};
   std::vector<planner::Landmark> landmarks = prior_landmarks_;
   const auto t0 = std::chrono::steady_clock::now();
-  for (const LandmarkTrack& t : associator_->tracks) {
+  const std::vector<LandmarkTrack>& tracks = associator_->tracks;
+  counted_.resize(tracks.size());
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    const LandmarkTrack& t = tracks[i];
     if (t.observations < config_.min_observations) {
       ++out.dropped_few_observations;
       continue;
@@ -219,9 +222,13 @@ IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTre
     lm.descriptor = t.descriptor;
     // Landmark::opportunities: the frames that had it in view, a sum over the frames in order; a
     // frame may have detected it twice (two keypoints merged into it): never below the detections.
-    int n = 0;
-    for (const View& view : views_) n += view.hadInView(lm.p_W, k_, config_) ? 1 : 0;
-    lm.opportunities = std::max(n, lm.observations);
+    // Counted again from the first frame only when its mean moved since the last count.
+    Counted& c = counted_[i];
+    if (c.observations != t.observations) c = Counted{t.observations, 0, 0};
+    for (; c.views < static_cast<int>(views_.size()); ++c.views) {
+      c.opportunities += views_[static_cast<std::size_t>(c.views)].hadInView(lm.p_W, k_, config_) ? 1 : 0;
+    }
+    lm.opportunities = std::max(c.opportunities, lm.observations);
     landmarks.push_back(lm);
   }
   out.opportunities_s = secondsSince(t0);
@@ -230,9 +237,7 @@ IncrementalMapper::Built IncrementalMapper::build(std::unique_ptr<octomap::OcTre
   return out;
 }
 
-IncrementalMapper::Built IncrementalMapper::snapshot() const {
-  return build(std::make_unique<octomap::OcTree>(*tree_));
-}
+IncrementalMapper::Built IncrementalMapper::snapshot() { return build(std::make_unique<octomap::OcTree>(*tree_)); }
 
 IncrementalMapper::Built IncrementalMapper::release() { return build(std::move(tree_)); }
 

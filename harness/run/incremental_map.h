@@ -78,15 +78,23 @@ class IncrementalMapper {
   };
   // The map so far (a copy; the mapper goes on): the prior's landmarks and the frames' landmarks
   // seen at least config.min_observations times, their opportunities counted over every observed
-  // frame, embedded in the occupancy.
-  Built snapshot() const;
+  // frame, embedded in the occupancy. A landmark not observed since the last snapshot keeps its
+  // count and has only the frames observed since counted (the same count, in less time).
+  Built snapshot();
   // The same, moving the occupancy out (the mapper is spent).
   Built release();
 
  private:
   struct Associator;
   struct View;
-  Built build(std::unique_ptr<octomap::OcTree> tree) const;
+  // A track's opportunities as last counted: over views [0, views) at its mean after
+  // `observations` observations (its mean changes only with a new observation).
+  struct Counted {
+    int observations = 0;
+    int views = 0;
+    int opportunities = 0;
+  };
+  Built build(std::unique_ptr<octomap::OcTree> tree);
 
   MapBuildConfig config_;
   Intrinsics k_;
@@ -94,6 +102,7 @@ class IncrementalMapper {
   std::unique_ptr<octomap::OcTree> tree_;
   std::unique_ptr<Associator> associator_;
   std::vector<View> views_;
+  std::vector<Counted> counted_;  // per track
   std::vector<planner::Landmark> prior_landmarks_;
   long keypoints_ = 0;
   long observations_ = 0;
