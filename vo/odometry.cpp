@@ -183,6 +183,8 @@ void OdometryConfig::validate() const {
   require(std::isfinite(min_depth_m) && min_depth_m > 0.0, "min_depth_m", min_depth_m, "must be > 0");
   require(std::isfinite(max_depth_m) && max_depth_m > min_depth_m, "max_depth_m", max_depth_m, "must be > min_depth_m");
   require(std::isfinite(depth_edge_m) && depth_edge_m > 0.0, "depth_edge_m", depth_edge_m, "must be > 0");
+  require(std::isfinite(depth_edge_radius_px) && depth_edge_radius_px >= 0.0 && depth_edge_radius_px <= 32.0,
+          "depth_edge_radius_px", depth_edge_radius_px, "must be in [0, 32]");
   require(init_min_features >= 4, "init_min_features", init_min_features, "must be >= 4");
   require(min_inliers >= 4, "min_inliers", min_inliers, "must be >= 4 (PnP)");
   require(weak_inliers >= min_inliers, "weak_inliers", weak_inliers, "must be >= min_inliers");
@@ -349,14 +351,20 @@ RgbdOdometry::PreparedFrame RgbdOdometry::prepare(double t_s, const cv::Mat& ima
 bool RgbdOdometry::backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const {
   const int u = static_cast<int>(std::lround(keypoint.pt.x));
   const int v = static_cast<int>(std::lround(keypoint.pt.y));
-  if (u < 1 || v < 1 || u >= depth_m.cols - 1 || v >= depth_m.rows - 1) return false;
+  const int r =
+      config_.depth_edge_radius_px > 0.0
+          ? std::max(
+                1, static_cast<int>(std::lround(config_.depth_edge_radius_px *
+                                                std::pow(config_.features.scale_factor, std::max(0, keypoint.octave)))))
+          : 1;
+  if (u < r || v < r || u >= depth_m.cols - r || v >= depth_m.rows - r) return false;
   const float z = depth_m.at<float>(v, u);
   if (!std::isfinite(z) || z < config_.min_depth_m || z > config_.max_depth_m) return false;
   // Depth discontinuity: a keypoint on an object's silhouette has no reliable depth.
   float lo = z, hi = z;
   bool holes = false;
-  for (int dv = -1; dv <= 1; ++dv) {
-    for (int du = -1; du <= 1; ++du) {
+  for (int dv = -r; dv <= r; ++dv) {
+    for (int du = -r; du <= r; ++du) {
       const float d = depth_m.at<float>(v + dv, u + du);
       if (!std::isfinite(d) || d <= 0.0f) holes = true;
       lo = std::min(lo, d);
@@ -457,6 +465,7 @@ RgbdOdometry::LocalMapMatches RgbdOdometry::matchLocalMap(const PreparedFrame& f
     m.object.emplace_back(p.x(), p.y(), p.z());
     m.pixels.emplace_back(f.keypoints[i].pt.x, f.keypoints[i].pt.y);
     m.keypoint.push_back(static_cast<int>(i));
+    m.depth_m.push_back(frame.valid[i] ? frame.p_C[i].z() : 0.0);
   }
   return m;
 }
@@ -482,9 +491,11 @@ RgbdOdometry::PoseEstimate RgbdOdometry::estimatePose(const LocalMapMatches& mat
   if (!pose.ransac_ok) return pose;
   std::vector<cv::Point3d> obj_in;
   std::vector<cv::Point2d> pix_in;
+  std::vector<double> depth_in;
   for (int i : inliers) {
     obj_in.push_back(matches.object[static_cast<std::size_t>(i)]);
     pix_in.push_back(matches.pixels[static_cast<std::size_t>(i)]);
+    depth_in.push_back(matches.depth_m[static_cast<std::size_t>(i)]);
   }
   Eigen::Isometry3d X_CW_ransac = Eigen::Isometry3d::Identity();
   {
@@ -500,10 +511,10 @@ RgbdOdometry::PoseEstimate RgbdOdometry::estimatePose(const LocalMapMatches& mat
   // Levenberg-Marquardt on RANSAC's inliers from two starts: RANSAC's pose, which EPnP on a
   // near-planar set (a wall filling the view) can get badly wrong, and the motion-model
   // prediction. The start whose refined pose has more inliers among all matches wins.
-  pose.inliers = refinePose(matches, obj_in, pix_in, X_CW_ransac, &pose.X_CW, &pose.is_inlier);
+  pose.inliers = refinePose(matches, obj_in, pix_in, depth_in, X_CW_ransac, &pose.X_CW, &pose.is_inlier);
   Eigen::Isometry3d X_CW_alt;
   std::vector<bool> alt_inlier;
-  const int n_alt = refinePose(matches, obj_in, pix_in, X_CW_pred, &X_CW_alt, &alt_inlier);
+  const int n_alt = refinePose(matches, obj_in, pix_in, depth_in, X_CW_pred, &X_CW_alt, &alt_inlier);
   if (n_alt > pose.inliers) {
     pose.inliers = n_alt;
     pose.X_CW = X_CW_alt;
@@ -512,14 +523,22 @@ RgbdOdometry::PoseEstimate RgbdOdometry::estimatePose(const LocalMapMatches& mat
   return pose;
 }
 
-// Levenberg-Marquardt from `start` on RANSAC's inliers (vo/pose_refine.h); returns the refined
-// pose's inliers among all matches (reprojection within ransac_reprojection_px), -1 if it failed.
+// Levenberg-Marquardt from `start` on RANSAC's inliers (vo/pose_refine.h; with pose_depth, their
+// measured depths too); returns the refined pose's inliers among all matches (reprojection within
+// ransac_reprojection_px), -1 if it failed.
 int RgbdOdometry::refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
-                             const std::vector<cv::Point2d>& pixels_in, const Eigen::Isometry3d& start,
-                             Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) const {
+                             const std::vector<cv::Point2d>& pixels_in, const std::vector<double>& depth_in,
+                             const Eigen::Isometry3d& start, Eigen::Isometry3d* X_CW,
+                             std::vector<bool>* is_inlier) const {
   *X_CW = start;
   is_inlier->assign(matches.object.size(), false);
-  if (!refinePoseLm(object_in, pixels_in, camera_, X_CW).ok) return -1;
+  PoseDepth depth;
+  if (config_.pose_depth) {
+    depth.depth_m = &depth_in;
+    depth.bf_px = camera_.fx * config_.ba.virtual_baseline_m;
+    depth.depth_sigma_px = config_.ba.depth_sigma_px;
+  }
+  if (!refinePoseLm(object_in, pixels_in, camera_, X_CW, 20, depth).ok) return -1;
   const double thr2 = config_.ransac_reprojection_px * config_.ransac_reprojection_px;
   int n = 0;
   for (std::size_t m = 0; m < matches.object.size(); ++m) {

@@ -62,11 +62,18 @@ class StageClock;  // vo/stage_clock.h
 
 struct OdometryConfig {
   FeatureConfig features;
-  double min_depth_m = 0.2;        // features with depth outside this range have no 3D point
-  double max_depth_m = 10.0;       // the sensor's range (a RealSense D435's, configs/camera.yaml);
-                                   // BA weighs a far point's depth by its noise
-  double depth_edge_m = 0.05;      // ... nor those on a depth discontinuity (3x3 spread above
-                                   // this times the depth)
+  double min_depth_m = 0.2;    // features with depth outside this range have no 3D point
+  double max_depth_m = 10.0;   // the sensor's range (a RealSense D435's, configs/camera.yaml);
+                               // BA weighs a far point's depth by its noise
+  double depth_edge_m = 0.05;  // ... nor those on a depth discontinuity (3x3 spread above
+                               // this times the depth)
+  // The neighbourhood of that check. 0: the keypoint's 3x3 pixels in the full image, whatever its
+  // pyramid level (before 2026-11-30). r > 0: the square of radius r x scale_factor^octave pixels,
+  // r pixels at the keypoint's own level (3: FAST's circle there). A corner that a near
+  // silhouette makes against a far texture (a T-junction) is no point in space: it slides along
+  // the silhouette as the camera moves; at a coarse level its circle reaches the silhouette from
+  // pixels beyond the 3x3.
+  double depth_edge_radius_px = 0.0;
   int init_min_features = 100;     // features with depth needed to start (or restart)
   int min_inliers = 30;            // below: lost (ORB-SLAM2: 30 local-map inliers)
   int weak_inliers = 60;           // below: weak
@@ -79,6 +86,12 @@ struct OdometryConfig {
   // it changes nothing before the first frame that would have been lost. false: the prediction's
   // window alone (before 2026-11-29).
   bool wide_retry = true;
+  // Each frame's pose refined on the matched keypoints' measured depths too (the disparity
+  // residual of ba.virtual_baseline_m and ba.depth_sigma_px, as ORB-SLAM2's motion-only BA for
+  // RGB-D), not on their reprojections alone. Reprojection alone let a frame whose matches
+  // crowded into part of the image jump 0.1-0.3 m along the optical axis with 160-250 inliers
+  // (gallery online). false: reprojection alone (before 2026-11-30).
+  bool pose_depth = false;
   int max_descriptor_distance = 64;  // Hamming, of 256 bits
   double ratio_test = 0.8;           // best / second best within the window
   double ransac_reprojection_px = 2.0;
@@ -107,11 +120,13 @@ struct OdometryConfig {
     a("min_depth_m", min_depth_m);
     a("max_depth_m", max_depth_m);
     a("depth_edge_m", depth_edge_m);
+    a("depth_edge_radius_px", depth_edge_radius_px);
     a("init_min_features", init_min_features);
     a("min_inliers", min_inliers);
     a("weak_inliers", weak_inliers);
     a("search_radius_px", search_radius_px);
     a("wide_retry", wide_retry);
+    a("pose_depth", pose_depth);
     a("max_descriptor_distance", max_descriptor_distance);
     a("ratio_test", ratio_test);
     a("ransac_reprojection_px", ransac_reprojection_px);
@@ -266,8 +281,8 @@ class RgbdOdometry {
   // Their parts.
   bool backProject(const cv::KeyPoint& keypoint, const cv::Mat& depth_m, Eigen::Vector3d* p_C) const;
   int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
-                 const std::vector<cv::Point2d>& pixels_in, const Eigen::Isometry3d& start, Eigen::Isometry3d* X_CW,
-                 std::vector<bool>* is_inlier) const;
+                 const std::vector<cv::Point2d>& pixels_in, const std::vector<double>& depth_in,
+                 const Eigen::Isometry3d& start, Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) const;
   // The keyframe rules that fire ('+'-joined; empty: none): ratioRules for the current pose and
   // inliers, orbSlam2Rules also from the frame's close features, tracked or not.
   std::string ratioRules(int inliers) const;

@@ -21,6 +21,7 @@ struct RgbdOdometry::LocalMapMatches {
   std::vector<cv::Point3d> object;  // landmark positions, in keypoint order
   std::vector<cv::Point2d> pixels;  // their keypoints' pixels
   std::vector<int> keypoint;        // correspondence -> keypoint
+  std::vector<double> depth_m;      // its keypoint's measured depth (0: none)
 };
 
 struct RgbdOdometry::PoseEstimate {

@@ -422,5 +422,30 @@ TEST(DecideStatus, TrackedFramesTakeTheStatusOfTheirInliers) {
   EXPECT_GT(ok, 0);
 }
 
+// A near plain surface covering the right half of a far texture: the corners its silhouette makes
+// on the texture are no points in space. Checked over 3x3 pixels, keypoints of the coarse pyramid
+// levels a few pixels off the silhouette keep a depth; over FAST's circle at each keypoint's own
+// level (depth_edge_radius_px: 3) they do not. Without a discontinuity both keep the same.
+TEST(Odometry, TheDepthEdgeCheckAtTheKeypointsLevelDropsCornersOnASilhouette) {
+  const cv::Mat tex = texture(kW, kH);
+  cv::Mat image = tex.clone();
+  image(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(128));
+  cv::Mat depth = flatDepth(5.0f);
+  depth(cv::Rect(kW / 2, 0, kW / 2, kH)).setTo(cv::Scalar(1.0f));
+  OdometryConfig level;
+  level.depth_edge_radius_px = 3.0;
+  auto withDepth = [&](const OdometryConfig& config, const cv::Mat& d) {
+    RgbdOdometry vo(camera(), config);
+    return vo.track(0.0, image, d).with_depth;
+  };
+  const int pixels = withDepth(OdometryConfig{}, depth);
+  const int at_level = withDepth(level, depth);
+  EXPECT_GT(pixels, 100);
+  EXPECT_LE(at_level, pixels - 5);  // 999 against 989 when written
+  EXPECT_EQ(withDepth(level, flatDepth(5.0f)), withDepth(OdometryConfig{}, flatDepth(5.0f)));
+  level.depth_edge_radius_px = -1.0;
+  EXPECT_THROW(RgbdOdometry(camera(), level), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace tgnav::vo
