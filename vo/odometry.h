@@ -72,7 +72,8 @@ struct OdometryConfig {
   // r pixels at the keypoint's own level (3: FAST's circle there). A corner that a near
   // silhouette makes against a far texture (a T-junction) is no point in space: it slides along
   // the silhouette as the camera moves; at a coarse level its circle reaches the silhouette from
-  // pixels beyond the 3x3.
+  // pixels beyond the 3x3. Measured at 3 (docs/results/vo_jumps): smaller errors, but fewer
+  // features with depth, and the VO lost sooner on sparse views.
   double depth_edge_radius_px = 0.0;
   int init_min_features = 100;     // features with depth needed to start (or restart)
   int min_inliers = 30;            // below: lost (ORB-SLAM2: 30 local-map inliers)
@@ -88,9 +89,8 @@ struct OdometryConfig {
   bool wide_retry = true;
   // Each frame's pose refined on the matched keypoints' measured depths too (the disparity
   // residual of ba.virtual_baseline_m and ba.depth_sigma_px, as ORB-SLAM2's motion-only BA for
-  // RGB-D), not on their reprojections alone. Reprojection alone let a frame whose matches
-  // crowded into part of the image jump 0.1-0.3 m along the optical axis with 160-250 inliers
-  // (gallery online). false: reprojection alone (before 2026-11-30).
+  // RGB-D), not on their reprojections alone. Measured (docs/results/vo_jumps): fewer frames
+  // tracked but placed 0.1-0.3 m off, not none; held-out replays mixed. false: reprojection alone.
   bool pose_depth = false;
   int max_descriptor_distance = 64;  // Hamming, of 256 bits
   double ratio_test = 0.8;           // best / second best within the window
