@@ -133,6 +133,9 @@ def setpoints(gt, offset, end_s):
                      g[3] - offset[2], yaw])
     if len(rows) < 2:
         raise InputError(f"fewer than 2 poses before {end_s:.2f} s")
+    for a, b in zip(rows, rows[1:]):
+        if not b[0] > a[0]:
+            raise InputError(f"time {b[0]} does not increase (after {a[0]})")
     for i in range(1, len(rows)):
         step = rows[i][4] - rows[i - 1][4]
         rows[i][4] -= 2.0 * math.pi * round(step / (2.0 * math.pi))

@@ -184,6 +184,9 @@ class VoReplayTest(unittest.TestCase):
         with open(os.path.join(self.trial, "gt.tum"), "a") as f:
             f.write("3.1 1 2 nan 0 0 0 1\n")
         self.assert_refused([self.trial], "gt.tum: line 33")
+        with open(os.path.join(self.trial, "gt.tum"), "w") as f:
+            f.write("0 0 0 1 0 0 0 1\n0.1 0 0 1 0 0 0 1\n0.1 0 0 1 0 0 0 1\n")
+        self.assert_refused([self.trial], "gt.tum: time 0.1 does not increase")
         self.assert_refused([self.trial, "--variant", "bad"], "--variant 'bad'")
         self.assert_refused([self.trial, "--variant", f"default={self.configs['jump']}"], "is taken")
         with open(os.path.join(self.trial, "config.yaml"), "w") as f:
