@@ -76,14 +76,15 @@ def load_tum(path):
     return rows
 
 
-def load_yaml(path):
+def load_mapping(path, parse=yaml.safe_load, kind="YAML"):
+    """The mapping a YAML (or, with json.load, JSON) file holds; InputError naming the file."""
     try:
         with open(path) as f:
-            data = yaml.safe_load(f)
+            data = parse(f)
     except OSError as e:
         raise InputError(f"{path}: {e.strerror}")
-    except yaml.YAMLError as e:
-        raise InputError(f"{path}: not YAML ({str(e).splitlines()[0]})")
+    except (yaml.YAMLError, json.JSONDecodeError) as e:
+        raise InputError(f"{path}: not {kind} ({str(e).splitlines()[0]})")
     if not isinstance(data, dict):
         raise InputError(f"{path}: expected a mapping")
     return data
@@ -91,7 +92,7 @@ def load_yaml(path):
 
 def camera_offset(vehicle_yaml):
     """The onboard camera's position in the body frame, from the vehicle's MJCF."""
-    vehicle = load_yaml(vehicle_yaml)
+    vehicle = load_mapping(vehicle_yaml)
     for key in ("mjcf", "camera", "body"):
         if not isinstance(vehicle.get(key), str):
             raise InputError(f"{vehicle_yaml}: key '{key}' missing or not a string")
@@ -203,7 +204,7 @@ def parse_variants(specs):
             raise InputError(f"--variant {spec!r}: expected NAME=FILE.yaml (NAME letters, digits, _)")
         if any(name == n for n, _ in variants):
             raise InputError(f"--variant {spec!r}: the name '{name}' is taken")
-        load_yaml(path)
+        load_mapping(path)
         variants.append((name, os.path.abspath(path)))
     return variants
 
@@ -217,15 +218,9 @@ def replay(trials, out, variants, tgnav, jump_m, max_s):
             raise InputError(f"{trial}: a trial of the same folder name is already listed")
         names.add(name)
         metrics_path = os.path.join(trial, "metrics.json")
-        try:
-            with open(metrics_path) as f:
-                metrics = json.load(f)
-        except OSError as e:
-            raise InputError(f"{metrics_path}: {e.strerror}")
-        except json.JSONDecodeError as e:
-            raise InputError(f"{metrics_path}: not JSON ({e.msg})")
+        metrics = load_mapping(metrics_path, json.load, "JSON")
         config_path = os.path.join(trial, "config.yaml")
-        config = load_yaml(config_path)
+        config = load_mapping(config_path)
         for key in ("scene", "vehicle"):
             if not isinstance(config.get(key), str):
                 raise InputError(f"{config_path}: key '{key}' missing or not a path")
