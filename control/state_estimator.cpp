@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -54,6 +55,8 @@ void EstimatorConfig::validate() const {
   require(history_s > 0.0, "history_s", history_s, "must be > 0");
   require(accel_bias_walk_m_s2_sqrt_s >= 0.0 && std::isfinite(accel_bias_walk_m_s2_sqrt_s),
           "accel_bias_walk_m_s2_sqrt_s", accel_bias_walk_m_s2_sqrt_s, "must be >= 0");
+  require(max_vo_step_error_m >= 0.0 && std::isfinite(max_vo_step_error_m), "max_vo_step_error_m", max_vo_step_error_m,
+          "must be >= 0 (0: off)");
 }
 
 StateEstimator::StateEstimator(const EstimatorConfig& config, double gravity_m_s2)
@@ -76,6 +79,9 @@ void StateEstimator::reset(const VehicleState& initial, double t_s) {
   has_fused_ = false;
   fused_ = 0;
   rejected_ = 0;
+  has_vo_ = false;
+  vo_offset_.setZero();
+  jumps_ = 0;
   history_.clear();
   history_.push_back(Snapshot{t_s_, x_, P_, q_WB_});
 }
@@ -125,14 +131,28 @@ bool StateEstimator::fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB) {
   }
   if (has_fused_ && t_meas_s < last_fused_t_s_) return reject();
   if (!X_WB.matrix().allFinite()) return reject();
-  auto it = std::lower_bound(history_.begin(), history_.end(), t_meas_s,
-                             [](const Snapshot& s, double t) { return s.t_s < t; });
-  if (it == history_.end() || (it != history_.begin() && t_meas_s - std::prev(it)->t_s < it->t_s - t_meas_s)) {
-    --it;
-  }
+  const auto it = history_.begin() + static_cast<std::ptrdiff_t>(nearest(t_meas_s));
   const Snapshot& m = *it;
 
-  const Eigen::Vector3d y = X_WB.translation() - m.x.head<3>();
+  Eigen::Vector3d p_meas = X_WB.translation();
+  if (config_.max_vo_step_error_m > 0.0) {
+    // The step since the last VO pose against the estimate's over the same time. A previous pose
+    // older than the history is no reference: the step is then taken as it is.
+    if (has_vo_ && last_vo_t_s_ >= history_.front().t_s - half_step) {
+      const Eigen::Vector3d error =
+          (p_meas - last_vo_p_) - (m.x.head<3>() - history_[nearest(last_vo_t_s_)].x.head<3>());
+      if (error.norm() > config_.max_vo_step_error_m) {
+        vo_offset_ += error;
+        ++jumps_;
+      }
+    }
+    last_vo_p_ = p_meas;
+    last_vo_t_s_ = t_meas_s;
+    has_vo_ = true;
+    p_meas -= vo_offset_;
+  }
+
+  const Eigen::Vector3d y = p_meas - m.x.head<3>();
   if (!(y.norm() <= config_.max_position_innovation_m)) return reject();
 
   // Kalman update at the snapshot, H = [I 0]: P H^T is P's left block column.
@@ -175,6 +195,13 @@ bool StateEstimator::fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB) {
   has_fused_ = true;
   ++fused_;
   return true;
+}
+
+std::size_t StateEstimator::nearest(double t_s) const {
+  auto it =
+      std::lower_bound(history_.begin(), history_.end(), t_s, [](const Snapshot& s, double t) { return s.t_s < t; });
+  if (it == history_.end() || (it != history_.begin() && t_s - std::prev(it)->t_s < it->t_s - t_s)) --it;
+  return static_cast<std::size_t>(it - history_.begin());
 }
 
 VehicleState StateEstimator::state() const {

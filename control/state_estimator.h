@@ -29,6 +29,7 @@
 // attitude correction is carried forward exactly too (as a rotation in W); the positions between
 // t_m and t are not re-integrated with the corrected attitude.
 #include <Eigen/Geometry>
+#include <cstddef>
 #include <deque>
 
 #include "control/types.h"
@@ -51,6 +52,12 @@ struct EstimatorConfig {
   double history_s = 1.0;                  // how old a fused measurement may be
   // Random walk of the acceleration bias b_W, sigma [m/s^2 per sqrt(s)]; 0: not estimated.
   double accel_bias_walk_m_s2_sqrt_s = 0.0;
+  // The VO's jumps [m]; 0: off. Where the VO's position moved between two poses by more than this
+  // away from what the estimate moved between their times (the IMU's prediction of that step, on
+  // the poses fused so far), the difference is a jump: it is added to an offset that every later
+  // pose is taken less of (voOffset()), so the estimate, and whatever uses the poses it corrects,
+  // goes on from where the IMU put it. A jump back, as large, takes it off again.
+  double max_vo_step_error_m = 0.0;
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -62,6 +69,7 @@ struct EstimatorConfig {
     a("max_position_innovation_m", max_position_innovation_m);
     a("history_s", history_s);
     a("accel_bias_walk_m_s2_sqrt_s", accel_bias_walk_m_s2_sqrt_s);
+    a("max_vo_step_error_m", max_vo_step_error_m);
   }
 
   void validate() const;  // std::invalid_argument naming the field and value
@@ -88,8 +96,12 @@ class StateEstimator {
   // Fuses a body pose measured at t_meas_s (<= the current time, within history_s). Returns
   // false (and changes nothing but rejected()) when it is rejected: too old (or in the future),
   // older than a pose already fused, not finite, or its position innovation is beyond
-  // max_position_innovation_m.
+  // max_position_innovation_m. With max_vo_step_error_m, the pose's position is taken less
+  // voOffset(), after its step was checked (a pose rejected by the innovation gate still is).
   bool fusePose(double t_meas_s, const Eigen::Isometry3d& X_WB);
+  // What is taken off the VO's positions (W): the sum of the jumps found (max_vo_step_error_m).
+  Eigen::Vector3d voOffset() const { return vo_offset_; }
+  int jumps() const { return jumps_; }  // VO steps taken as jumps
 
   VehicleState state() const;
   double time() const { return t_s_; }
@@ -118,6 +130,15 @@ class StateEstimator {
   double last_fused_t_s_ = 0.0;                       // measurement time of the last fused pose
   bool has_fused_ = false;
   std::deque<Snapshot> history_;
+  // The index in history_ of the snapshot nearest t_s (history_ is never empty; t_s outside it
+  // gives the nearest end).
+  std::size_t nearest(double t_s) const;
+  // The step check of max_vo_step_error_m: the VO position before the offset, and its time.
+  Eigen::Vector3d last_vo_p_ = Eigen::Vector3d::Zero();
+  double last_vo_t_s_ = 0.0;
+  bool has_vo_ = false;
+  Eigen::Vector3d vo_offset_ = Eigen::Vector3d::Zero();
+  int jumps_ = 0;
   int fused_ = 0;
   int rejected_ = 0;
 };

@@ -159,6 +159,8 @@ class ClosedLoop {
     fillProfile();
     result_->vo_fused = estimator_.fused();
     result_->vo_rejected = estimator_.rejected();
+    result_->vo_jumps = estimator_.jumps();
+    result_->vo_offset_m = estimator_.voOffset().norm();
     if (online_ != nullptr) finishOnline();
     return events();
   }
@@ -335,13 +337,17 @@ class ClosedLoop {
     fused_up_to_ = k;
     fused_pose_index_ = k;
     fused_pose_.reset();
-    if (d.vo.status != vo::TrackingStatus::kLost) fused_pose_ = d.vo.X_WC;
     if (d.vo.status == vo::TrackingStatus::kLost) {
       if (!reinitialise_) vo_failed_known_ = true;  // among the fused results: the same in both modes
       return;
     }
-    if (online_ != nullptr) online_->trackFrame(data_->time, timeline_.trajectory_start_s, d.vo);
     estimator_.fusePose(d.vo.t_s, d.vo.X_WC * X_CB_);
+    // The map and the guard take the pose as the estimator did: less the VO's jumps found so far
+    // (trial.estimator.max_vo_step_error_m; none when off).
+    vo::FrameResult frame = d.vo;
+    frame.X_WC.translation() -= estimator_.voOffset();
+    fused_pose_ = frame.X_WC;
+    if (online_ != nullptr) online_->trackFrame(data_->time, timeline_.trajectory_start_s, frame);
   }
 
   void reportProgress(const FlightLoop& l) const {

@@ -204,6 +204,8 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["tracking_rmse_m"] = tracking.position_rmse_m;
   j["vo_poses_fused"] = result.vo_fused;
   j["vo_poses_rejected"] = result.vo_rejected;
+  j["vo_jumps_taken_off"] = result.vo_jumps;
+  j["vo_offset_m"] = result.vo_offset_m;
   j["camera"] = {{"width_px", scenario.camera.width_px},
                  {"height_px", scenario.camera.height_px},
                  {"rate_hz", scenario.trial.camera_rate_hz}};

@@ -3,7 +3,8 @@
 // with a noisy IMU and late VO poses is tracked to centimetres while dead reckoning drifts away;
 // late fusion equals in-time fusion; the gate leaves the state untouched; the covariance stays
 // symmetric positive definite; the attitude error decays by (1 - attitude_gain) per pose; the
-// gyro bias is learnt; the gravity a tilted VO attitude leaks is learnt as an acceleration bias.
+// gyro bias is learnt; the gravity a tilted VO attitude leaks is learnt as an acceleration bias;
+// a VO jump is found by its step against the IMU's and taken off the poses after it.
 #include "control/state_estimator.h"
 
 #include <gtest/gtest.h>
@@ -535,6 +536,96 @@ TEST(StateEstimator, ATiltedVoAttitudeBiasesTheVelocityUnlessTheAccelerationBias
   EXPECT_LT((bias_learnt - leak).norm(), 0.05 * leak.norm());
 }
 
+// The circle flown with a noisy IMU and VO poses of `vo_sigma` white noise plus `vo_error(frame)`
+// (frame 1 is the first pose fused), each fused one camera period late. Returns the largest
+// position error over the last `tail_s` seconds.
+struct JumpFlight {
+  double max_tail_error_m = 0.0;
+  int jumps = 0;
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+};
+JumpFlight flyWithVoError(const EstimatorConfig& config, std::uint64_t seed, double vo_sigma,
+                          const std::function<Eigen::Vector3d(int)>& vo_error, double duration_s = 12.0,
+                          double tail_s = 4.0) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  auto gaussian = [&](double sigma) -> Eigen::Vector3d {
+    return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)) * sigma;
+  };
+  const Sensors sensors;
+  const Eigen::Vector3d accel_bias = gaussian(sensors.accel_bias);
+  StateEstimator est(config, kG);
+  est.reset(Flight::state(0.0), 0.0);
+  Eigen::Isometry3d pending = pose(Flight::p(0.0), Flight::q(0.0));
+  JumpFlight out;
+  int frame = 0;
+  const int steps = static_cast<int>(std::lround(duration_s / kDt));
+  for (int k = 1; k <= steps; ++k) {
+    const double t = k * kDt;
+    ImuSample imu = Flight::imu(t, kDt);
+    imu.f_B += accel_bias + gaussian(sensors.accel_noise);
+    imu.w_B += gaussian(sensors.gyro_noise);
+    est.propagate(imu);
+    if (k % kStepsPerFrame == 0) {
+      est.fusePose(t - kLatency, pending);
+      ++frame;
+      pending = pose(Flight::p(t) + gaussian(vo_sigma) + vo_error(frame), Flight::q(t));
+    }
+    if (t > duration_s - tail_s) {
+      out.max_tail_error_m = std::max(out.max_tail_error_m, (est.state().p_WB - Flight::p(t)).norm());
+    }
+  }
+  out.jumps = est.jumps();
+  out.offset = est.voOffset();
+  return out;
+}
+
+TEST(StateEstimator, AVoJumpIsTakenOffAndTheEstimateGoesOnFromTheImu) {
+  // From frame 100 (5 s) on, every VO pose is 0.25 m off: the VO jumped and tracked on from there.
+  // Off, the estimate follows the VO there; with the step check, the jump is found in its one
+  // step, taken off every later pose, and the estimate stays on the true flight.
+  const Eigen::Vector3d jump(0.15, -0.1, 0.17);  // 0.25 m
+  auto jumped = [&](int frame) -> Eigen::Vector3d { return frame >= 100 ? jump : Eigen::Vector3d::Zero(); };
+  EstimatorConfig off;
+  EstimatorConfig on;
+  on.max_vo_step_error_m = 0.08;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const JumpFlight a = flyWithVoError(off, seed, 0.01, jumped);
+    const JumpFlight b = flyWithVoError(on, seed, 0.01, jumped);
+    std::printf("seed %d: after a 0.25 m VO jump, largest error over the last 4 s: %.3f m off, %.3f m on\n",
+                static_cast<int>(seed), a.max_tail_error_m, b.max_tail_error_m);
+    EXPECT_GT(a.max_tail_error_m, 0.2) << "seed " << seed;
+    EXPECT_EQ(a.jumps, 0);
+    EXPECT_LT(b.max_tail_error_m, 0.05) << "seed " << seed;
+    EXPECT_EQ(b.jumps, 1) << "seed " << seed;
+    EXPECT_LT((b.offset - jump).norm(), 0.04) << "seed " << seed;
+  }
+}
+
+TEST(StateEstimator, AVoJumpAndItsReturnLeaveNoOffsetAndNoiseAloneIsNoJump) {
+  EstimatorConfig on;
+  on.max_vo_step_error_m = 0.08;
+  // One pose 0.3 m off, the next back on the flight: two jumps that cancel.
+  auto spike = [](int frame) -> Eigen::Vector3d {
+    return frame == 100 ? Eigen::Vector3d(0.0, 0.3, 0.0) : Eigen::Vector3d::Zero();
+  };
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const JumpFlight f = flyWithVoError(on, seed, 0.01, spike);
+    EXPECT_EQ(f.jumps, 2) << "seed " << seed;
+    EXPECT_LT(f.offset.norm(), 0.04) << "seed " << seed;
+    EXPECT_LT(f.max_tail_error_m, 0.05) << "seed " << seed;
+  }
+  // Noise alone, 1 cm per pose (a step's error has 1.4 cm per axis): no step is a jump, and the
+  // flight is tracked as with the check off, to the bit.
+  auto none = [](int) { return Eigen::Vector3d::Zero(); };
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    const JumpFlight f = flyWithVoError(on, seed, 0.01, none, 20.0, 20.0);
+    const JumpFlight g = flyWithVoError(EstimatorConfig{}, seed, 0.01, none, 20.0, 20.0);
+    EXPECT_EQ(f.jumps, 0) << "seed " << seed;
+    EXPECT_EQ(f.max_tail_error_m, g.max_tail_error_m) << "seed " << seed;
+  }
+}
+
 TEST(EstimatorConfig, ValidateNamesTheBadField) {
   EXPECT_NO_THROW(EstimatorConfig{}.validate());
   const double nan = std::nan("");
@@ -546,6 +637,7 @@ TEST(EstimatorConfig, ValidateNamesTheBadField) {
       {"max_position_innovation_m", [](EstimatorConfig& c, double v) { c.max_position_innovation_m = v; }},
       {"history_s", [](EstimatorConfig& c, double v) { c.history_s = v; }},
       {"accel_bias_walk_m_s2_sqrt_s", [](EstimatorConfig& c, double v) { c.accel_bias_walk_m_s2_sqrt_s = v; }},
+      {"max_vo_step_error_m", [](EstimatorConfig& c, double v) { c.max_vo_step_error_m = v; }},
   };
   const std::vector<std::vector<double>> bad = {{0.0, -1.0, nan},
                                                 {0.0, -0.01, nan},
@@ -553,6 +645,7 @@ TEST(EstimatorConfig, ValidateNamesTheBadField) {
                                                 {-0.1, 1.0, nan},
                                                 {0.0, -1.0, nan},
                                                 {0.0, -1.0, nan},
+                                                {-0.01, nan, std::numeric_limits<double>::infinity()},
                                                 {-0.01, nan, std::numeric_limits<double>::infinity()}};
   for (std::size_t i = 0; i < fields.size(); ++i) {
     for (double value : bad[i]) {
