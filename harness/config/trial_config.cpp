@@ -51,8 +51,8 @@ const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames() {
 }
 
 const std::vector<std::pair<std::string, UnseenPrior>>& unseenPriorNames() {
-  static const std::vector<std::pair<std::string, UnseenPrior>> names = {{"blind", UnseenPrior::kBlind},
-                                                                         {"mean", UnseenPrior::kMean}};
+  static const std::vector<std::pair<std::string, UnseenPrior>> names = {
+      {"blind", UnseenPrior::kBlind}, {"mean", UnseenPrior::kMean}, {"route_mean", UnseenPrior::kRouteMean}};
   return names;
 }
 

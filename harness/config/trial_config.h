@@ -66,9 +66,11 @@ enum class UnknownSpace { kFree, kBlocked };
 const std::vector<std::pair<std::string, UnknownSpace>>& unknownSpaceNames();  // "free", "blocked"
 // How the perception model rates surfaces an online trial has not seen yet (harness/run/unseen_prior.h):
 // blind (no landmarks: a view of them gives the VO nothing), or textured like the surfaces seen so
-// far on average (mean: landmarks on the boundary of the observed free space).
-enum class UnseenPrior { kBlind, kMean };
-const std::vector<std::pair<std::string, UnseenPrior>>& unseenPriorNames();  // "blind", "mean"
+// far on average (mean: landmarks on the boundary of the observed free space), or, with the
+// proposed planner, mean for the choice of route (the homology class) and blind for the path and
+// the views flown along it (route_mean; the other planners take it as blind).
+enum class UnseenPrior { kBlind, kMean, kRouteMean };
+const std::vector<std::pair<std::string, UnseenPrior>>& unseenPriorNames();  // "blind", "mean", "route_mean"
 
 // The keys of an online trial (flat in `trial:`); unused in prior mode.
 struct OnlineConfig {

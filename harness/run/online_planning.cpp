@@ -87,35 +87,64 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.record.trigger = trigger;
   a.record.start = start;
   const auto t0 = std::chrono::steady_clock::now();
-  IncrementalMapper::Built built = mapper_.snapshot();
   visited_.push_back(start.p_WB);
+  // The map planned on: a snapshot, with the visited places free (unknown_space blocked) and the
+  // guard's wedges blocked.
+  const auto snapshot = [&] {
+    IncrementalMapper::Built b = mapper_.snapshot();
+    const double clear = scenario_.planner.perception.robot_radius_m + 2.0 * b.map.resolution();
+    if (cfg_.unknown_space == UnknownSpace::kBlocked) {
+      std::vector<Eigen::Vector3d> free = visited_;
+      free.push_back(scenario_.scene.goal.p_WB);
+      markFree(&b.map.occupancy(), free, clear, clearanceBand(scenario_));
+    }
+    if (!wedges_.empty()) {
+      std::vector<Eigen::Vector3d> keep = visited_;
+      keep.push_back(scenario_.scene.goal.p_WB);
+      blockWedges(&b.map.occupancy(), wedges_, clearanceBand(scenario_), keep, clear);
+    }
+    return b;
+  };
+  const auto addPrior = [&](planner::FeatureMap* map) {
+    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
+    return addUnseenPrior(map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
+  };
+  IncrementalMapper::Built built = snapshot();
   const double clear_m = scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution();
-  if (cfg_.unknown_space == UnknownSpace::kBlocked) {
-    std::vector<Eigen::Vector3d> free = visited_;
-    free.push_back(scenario_.scene.goal.p_WB);
-    markFree(&built.map.occupancy(), free, clear_m, clearanceBand(scenario_));
-  }
-  if (!wedges_.empty()) {
-    std::vector<Eigen::Vector3d> keep = visited_;
-    keep.push_back(scenario_.scene.goal.p_WB);
-    blockWedges(&built.map.occupancy(), wedges_, clearanceBand(scenario_), keep, clear_m);
-  }
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   if (cfg_.unseen_prior == UnseenPrior::kMean && !external_ && planner_ != planner::PlannerKind::kAgnostic) {
-    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
-    a.record.prior_landmarks =
-        addUnseenPrior(&built.map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
+    a.record.prior_landmarks = addPrior(&built.map);
   }
   a.record.snapshot_s = secondsSince(t0);
-  const Scenario from_here = planningScenario(start);
+  Scenario from_here = planningScenario(start);
   const double rate_hz = scenario_.planner.trajectory.sample_rate_hz;
+  const bool unknown_free = cfg_.unknown_space == UnknownSpace::kFree;
   if (external_) {
     if (!askExternal(from_here, built.map, &a)) return a;
   } else {
-    a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
-                       cfg_.unknown_space == UnknownSpace::kFree);
-    a.record.voxel_map_s = a.run.voxel_map_s;
-    a.record.solve_s = a.run.solve_s;
+    // route_mean: the route's class is chosen on a second snapshot of the same map (the same
+    // occupancy, so the same classes) with the mean prior added; the path and its views are then
+    // planned in that class on the map as seen.
+    if (cfg_.unseen_prior == UnseenPrior::kRouteMean && planner_ == planner::PlannerKind::kProposed &&
+        from_here.planner.oracle_class < 0) {
+      const auto t1 = std::chrono::steady_clock::now();
+      IncrementalMapper::Built rated = snapshot();
+      a.record.prior_landmarks = addPrior(&rated.map);
+      a.record.snapshot_s += secondsSince(t1);
+      const PlanRun choice =
+          runPlanner(from_here, rated.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
+      a.record.voxel_map_s += choice.voxel_map_s;
+      a.record.solve_s += choice.solve_s;
+      a.record.rated_class = choice.plan.chosen_class;
+      from_here.planner.oracle_class = choice.plan.chosen_class;  // -1 (no route): the planner chooses
+    }
+    a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
+    if (a.record.rated_class >= 0 && a.run.plan.chosen < 0) {  // that class has no path here: the planner chooses
+      from_here.planner.oracle_class = -1;
+      a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
+    }
+    a.record.voxel_map_s += a.run.voxel_map_s;
+    a.record.solve_s += a.run.solve_s;
     a.record.trajectory_s = a.run.trajectory_s;
     if (a.run.plan.chosen < 0 || !a.run.trajectory.trajectory) {
       a.record.detail = a.run.plan.chosen < 0 ? std::string("no path: ") + planner::toString(a.run.plan.status)

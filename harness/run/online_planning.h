@@ -75,9 +75,12 @@ struct OnlinePlan {
   int look_seen = -1;
   bool look_way = false;
   bool look_goal = false;
-  int look_cells = 0;        // cells whose views the search rated
-  int landmarks = 0;         // in the map it planned on
-  int prior_landmarks = 0;   // ... and those of trial.unseen_prior added to it (unseen_prior.h)
+  int look_cells = 0;       // cells whose views the search rated
+  int landmarks = 0;        // in the map it planned on
+  int prior_landmarks = 0;  // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
+  // trial.unseen_prior route_mean: the class the plan on the map with the mean prior chose, which
+  // this plan then flies (-1: none, or not asked)
+  int rated_class = -1;
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
   double voxel_map_s = 0.0;  // wall clock
   double solve_s = 0.0;

@@ -220,6 +220,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["look_cells"] = p.look_cells;
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;
+    j["rated_class"] = p.rated_class;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < p.path.size(); ++i) {
       path.push_back({p.path[i].x(), p.path[i].y(), p.path[i].z(), p.path_unknown[i] ? 1 : 0});

@@ -154,7 +154,7 @@ TEST(OnlineTrial, StoppingBeforeUnknownSpaceShortensTheFirstTrajectoryFromNoMap)
   EXPECT_TRUE(readJson(dir / "stop/online.json")["plans"][0]["adopted"].get<bool>());
 }
 
-TEST(OnlineTrial, TheMeanPriorForUnseenSurfacesAddsLandmarksOnceSurfacesHaveBeenSeen) {
+TEST(OnlineTrial, TheMeanPriorForUnseenSurfacesAddsLandmarksOnceSurfacesHaveBeenSeenAndRouteMeanChoosesTheClassWithIt) {
   // trial.unseen_prior: mean. At take-off nothing is seen, so there is nothing to average: the
   // first plan gets no prior landmarks. The next one (the first keyframe sees the smoke scene's wall
   // across the straight line: `blocked`) does; the default (blind) adds none.
@@ -172,7 +172,22 @@ TEST(OnlineTrial, TheMeanPriorForUnseenSurfacesAddsLandmarksOnceSurfacesHaveBeen
   EXPECT_GT(mean[1]["landmarks"].get<int>(), 0);
   EXPECT_GT(mean[1]["prior_landmarks"].get<int>(), 0);
   EXPECT_EQ(mean[1]["landmarks"], blind[1]["landmarks"]);  // the same map so far; the prior is on top
-  for (const nlohmann::json& p : blind) EXPECT_EQ(p["prior_landmarks"], 0);
+  for (const nlohmann::json& p : blind) {
+    EXPECT_EQ(p["prior_landmarks"], 0);
+    EXPECT_EQ(p["rated_class"], -1);
+  }
+  // route_mean: the class is chosen with the prior (its landmarks counted as mean's), and the plan
+  // flies that class on the map without it (its landmarks: the blind map's).
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.unseen_prior=route_mean --out " + (dir / "route").string())).rc, 0);
+  const nlohmann::json route = readJson(dir / "route/online.json")["plans"];
+  ASSERT_GE(route.size(), 2U);
+  EXPECT_EQ(route[1]["landmarks"], blind[1]["landmarks"]);
+  EXPECT_EQ(route[1]["prior_landmarks"], mean[1]["prior_landmarks"]);
+  for (const nlohmann::json& p : route) {
+    if (!p["ok"].get<bool>()) continue;
+    EXPECT_GE(p["rated_class"].get<int>(), 0);
+    EXPECT_EQ(p["rated_class"], p["chosen_class"]);
+  }
 }
 
 TEST(OnlineTrial, HoldingTheFirstPlanFliesTheOneMadeOnWhatTheCameraMappedAndTheRangeBoundsTheMap) {
