@@ -83,6 +83,14 @@ struct ImuSample {
   Eigen::Vector3d w_B = Eigen::Vector3d::Zero();  // [rad/s]
 };
 
+// What the estimator did with the VO's poses (state source vo).
+struct FusionTally {
+  int fused = 0;          // VO poses taken
+  int rejected = 0;       // ... rejected (its gate, time window, not finite)
+  int jumps = 0;          // steps taken as the VO's jumps (max_vo_step_error_m)
+  double offset_m = 0.0;  // the size of their sum, taken off the VO's positions
+};
+
 class StateEstimator {
  public:
   StateEstimator(const EstimatorConfig& config, double gravity_m_s2);
@@ -102,6 +110,7 @@ class StateEstimator {
   // What is taken off the VO's positions (W): the sum of the jumps found (max_vo_step_error_m).
   Eigen::Vector3d voOffset() const { return vo_offset_; }
   int jumps() const { return jumps_; }  // VO steps taken as jumps
+  FusionTally tally() const { return {fused_, rejected_, jumps_, vo_offset_.norm()}; }
 
   VehicleState state() const;
   double time() const { return t_s_; }

@@ -88,28 +88,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.record.start = start;
   const auto t0 = std::chrono::steady_clock::now();
   visited_.push_back(start.p_WB);
-  // The map planned on: a snapshot, with the visited places free (unknown_space blocked) and the
-  // guard's wedges blocked.
-  const auto snapshot = [&] {
-    IncrementalMapper::Built b = mapper_.snapshot();
-    const double clear = scenario_.planner.perception.robot_radius_m + 2.0 * b.map.resolution();
-    if (cfg_.unknown_space == UnknownSpace::kBlocked) {
-      std::vector<Eigen::Vector3d> free = visited_;
-      free.push_back(scenario_.scene.goal.p_WB);
-      markFree(&b.map.occupancy(), free, clear, clearanceBand(scenario_));
-    }
-    if (!wedges_.empty()) {
-      std::vector<Eigen::Vector3d> keep = visited_;
-      keep.push_back(scenario_.scene.goal.p_WB);
-      blockWedges(&b.map.occupancy(), wedges_, clearanceBand(scenario_), keep, clear);
-    }
-    return b;
-  };
-  const auto addPrior = [&](planner::FeatureMap* map) {
-    const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
-    return addUnseenPrior(map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
-  };
-  IncrementalMapper::Built built = snapshot();
+  IncrementalMapper::Built built = planningSnapshot();
   const double clear_m = scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution();
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   if (cfg_.unseen_prior == UnseenPrior::kMean && !external_ && planner_ != planner::PlannerKind::kAgnostic) {
@@ -122,21 +101,9 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   if (external_) {
     if (!askExternal(from_here, built.map, &a)) return a;
   } else {
-    // route_mean: the route's class is chosen on a second snapshot of the same map (the same
-    // occupancy, so the same classes) with the mean prior added; the path and its views are then
-    // planned in that class on the map as seen.
     if (cfg_.unseen_prior == UnseenPrior::kRouteMean && planner_ == planner::PlannerKind::kProposed &&
         from_here.planner.oracle_class < 0) {
-      const auto t1 = std::chrono::steady_clock::now();
-      IncrementalMapper::Built rated = snapshot();
-      a.record.prior_landmarks = addPrior(&rated.map);
-      a.record.snapshot_s += secondsSince(t1);
-      const PlanRun choice =
-          runPlanner(from_here, rated.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
-      a.record.voxel_map_s += choice.voxel_map_s;
-      a.record.solve_s += choice.solve_s;
-      a.record.rated_class = choice.plan.chosen_class;
-      from_here.planner.oracle_class = choice.plan.chosen_class;  // -1 (no route): the planner chooses
+      from_here.planner.oracle_class = rateClass(from_here, &a.record);  // -1 (no route): the planner chooses
     }
     a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
     if (a.record.rated_class >= 0 && a.run.plan.chosen < 0) {  // that class has no path here: the planner chooses
@@ -171,6 +138,40 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   a.trajectory = external_ ? *a.raw : lookAhead(*a.raw, built.map, *a.run.voxels);
   a.map = std::move(built.map);
   return a;
+}
+
+IncrementalMapper::Built OnlinePlanning::planningSnapshot() {
+  IncrementalMapper::Built b = mapper_.snapshot();
+  const double clear = scenario_.planner.perception.robot_radius_m + 2.0 * b.map.resolution();
+  if (cfg_.unknown_space == UnknownSpace::kBlocked) {
+    std::vector<Eigen::Vector3d> free = visited_;
+    free.push_back(scenario_.scene.goal.p_WB);
+    markFree(&b.map.occupancy(), free, clear, clearanceBand(scenario_));
+  }
+  if (!wedges_.empty()) {
+    std::vector<Eigen::Vector3d> keep = visited_;
+    keep.push_back(scenario_.scene.goal.p_WB);
+    blockWedges(&b.map.occupancy(), wedges_, clearanceBand(scenario_), keep, clear);
+  }
+  return b;
+}
+
+int OnlinePlanning::addPrior(planner::FeatureMap* map) const {
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
+  return addUnseenPrior(map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
+}
+
+int OnlinePlanning::rateClass(const Scenario& from_here, OnlinePlan* record) {
+  const auto t0 = std::chrono::steady_clock::now();
+  IncrementalMapper::Built rated = planningSnapshot();
+  record->prior_landmarks = addPrior(&rated.map);
+  record->snapshot_s += secondsSince(t0);
+  const PlanRun choice = runPlanner(from_here, rated.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
+                                    cfg_.unknown_space == UnknownSpace::kFree);
+  record->voxel_map_s += choice.voxel_map_s;
+  record->solve_s += choice.solve_s;
+  record->rated_class = choice.plan.chosen_class;
+  return record->rated_class;
 }
 
 bool OnlinePlanning::stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a) {

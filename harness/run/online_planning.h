@@ -163,6 +163,16 @@ class OnlinePlanning {
   Attempt plan(const planner::Pose4& start, double t_s, const std::string& trigger);
   // The scenario a plan from `start` is made in (with plan_look_ahead, the pose graph's look_unknown_m).
   Scenario planningScenario(const planner::Pose4& start) const;
+  // The map a plan is made on: a snapshot, with the places planned from and the goal free
+  // (unknown_space blocked) and the guard's wedges blocked.
+  IncrementalMapper::Built planningSnapshot();
+  // Adds trial.unseen_prior's mean landmarks to `map` (unseen_prior.h); returns how many.
+  int addPrior(planner::FeatureMap* map) const;
+  // unseen_prior route_mean: the homology class the proposed planner chooses from `from_here` on a
+  // second snapshot with the mean prior (the same occupancy, so the same classes as the plan's own
+  // map); the path and its views are then planned in that class on the map as seen. Records it,
+  // the prior's landmarks and the time; -1 where it finds no route.
+  int rateClass(const Scenario& from_here, OnlinePlan* record);
   // Why a plan is asked now ("blind_view", "blocked", "goal_seen" or "period"); clears the events.
   std::string takeTrigger();
   // plan(), and where a built-in planner finds `start` within the robot radius of the map

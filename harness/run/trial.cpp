@@ -157,10 +157,7 @@ class ClosedLoop {
     result_->sim_time_s = data_->time;
     collectFrames(std::move(done));
     fillProfile();
-    result_->vo_fused = estimator_.fused();
-    result_->vo_rejected = estimator_.rejected();
-    result_->vo_jumps = estimator_.jumps();
-    result_->vo_offset_m = estimator_.voOffset().norm();
+    result_->vo_fusion = estimator_.tally();
     if (online_ != nullptr) finishOnline();
     return events();
   }
@@ -342,11 +339,8 @@ class ClosedLoop {
       return;
     }
     estimator_.fusePose(d.vo.t_s, d.vo.X_WC * X_CB_);
-    // The map and the guard take the pose as the estimator did: less the VO's jumps found so far
-    // (trial.estimator.max_vo_step_error_m; none when off).
-    vo::FrameResult frame = d.vo;
-    frame.X_WC.translation() -= estimator_.voOffset();
-    fused_pose_ = frame.X_WC;
+    vo::FrameResult frame = d.vo;  // the map and the guard take it as the estimate did: less the jumps found
+    fused_pose_ = frame.X_WC = Eigen::Translation3d(-estimator_.voOffset()) * d.vo.X_WC;
     if (online_ != nullptr) online_->trackFrame(data_->time, timeline_.trajectory_start_s, frame);
   }
 

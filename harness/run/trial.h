@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "control/state_estimator.h"
 #include "harness/config/scenario.h"
 #include "harness/run/external_plan.h"
 #include "harness/run/frame_prediction.h"
@@ -93,12 +94,9 @@ struct TrialResult {
   double sim_time_s = 0.0;
   double flight_wall_s = 0.0;
   double planned_flight_s = 0.0;
-  int vo_fused = 0;            // VO poses the estimator took (state source vo)
-  int vo_rejected = 0;         // ... and rejected by its gate
-  int vo_jumps = 0;            // ... steps it took as the VO's jumps (estimator.max_vo_step_error_m)
-  double vo_offset_m = 0.0;    // ... the size of their sum, taken off the VO's positions at the end
-  TrialProfile profile;        // where the flight's wall time went (trial_profile.h)
-  std::vector<cv::Mat> strip;  // frames for the frame strip (TrialOptions::strip_frames)
+  control::FusionTally vo_fusion;  // what the estimator did with the VO's poses (state source vo)
+  TrialProfile profile;            // where the flight's wall time went (trial_profile.h)
+  std::vector<cv::Mat> strip;      // frames for the frame strip (TrialOptions::strip_frames)
   std::vector<std::string> strip_captions;
 };
 

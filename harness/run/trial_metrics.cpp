@@ -145,6 +145,14 @@ void addOnlineTiming(const OnlineResult& o, int frames, nlohmann::ordered_json* 
   (*timing)["map_update_ms_per_frame"] = frames > 0 ? 1e3 * o.map_update_s / frames : 0.0;
 }
 
+// What the estimator did with the VO's poses (metrics.json's vo_* keys).
+nlohmann::ordered_json fusionJson(const control::FusionTally& f) {
+  return {{"vo_poses_fused", f.fused},
+          {"vo_poses_rejected", f.rejected},
+          {"vo_jumps_taken_off", f.jumps},
+          {"vo_offset_m", f.offset_m}};
+}
+
 }  // namespace
 
 nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOptions& options,
@@ -202,10 +210,7 @@ nlohmann::ordered_json trialMetricsJson(const Scenario& scenario, const TrialOpt
   j["trajectory_status"] = trajectory_given ? "given" : planner::toString(result.plan.trajectory.status);
   const TrackingSummary tracking = summarizeTracking(result.flight);
   j["tracking_rmse_m"] = tracking.position_rmse_m;
-  j["vo_poses_fused"] = result.vo_fused;
-  j["vo_poses_rejected"] = result.vo_rejected;
-  j["vo_jumps_taken_off"] = result.vo_jumps;
-  j["vo_offset_m"] = result.vo_offset_m;
+  j.update(fusionJson(result.vo_fusion));
   j["camera"] = {{"width_px", scenario.camera.width_px},
                  {"height_px", scenario.camera.height_px},
                  {"rate_hz", scenario.trial.camera_rate_hz}};
