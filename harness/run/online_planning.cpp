@@ -89,7 +89,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
   const auto t0 = std::chrono::steady_clock::now();
   visited_.push_back(start.p_WB);
   IncrementalMapper::Built built = planningSnapshot();
-  const double clear_m = scenario_.planner.perception.robot_radius_m + 2.0 * built.map.resolution();
+  const double clear_m = clearOf(built.map);
   a.record.landmarks = static_cast<int>(built.map.landmarks().size());
   if (cfg_.unseen_prior == UnseenPrior::kMean && !external_ && planner_ != planner::PlannerKind::kAgnostic) {
     a.record.prior_landmarks = addPrior(&built.map);
@@ -142,7 +142,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
 
 IncrementalMapper::Built OnlinePlanning::planningSnapshot() {
   IncrementalMapper::Built b = mapper_.snapshot();
-  const double clear = scenario_.planner.perception.robot_radius_m + 2.0 * b.map.resolution();
+  const double clear = clearOf(b.map);
   if (cfg_.unknown_space == UnknownSpace::kBlocked) {
     std::vector<Eigen::Vector3d> free = visited_;
     free.push_back(scenario_.scene.goal.p_WB);
@@ -156,6 +156,10 @@ IncrementalMapper::Built OnlinePlanning::planningSnapshot() {
   return b;
 }
 
+double OnlinePlanning::clearOf(const planner::FeatureMap& map) const {
+  return scenario_.planner.perception.robot_radius_m + 2.0 * map.resolution();
+}
+
 int OnlinePlanning::addPrior(planner::FeatureMap* map) const {
   const Eigen::Vector3d margin = Eigen::Vector3d::Constant(kPlanningBoxMargin_m);
   return addUnseenPrior(map, scenario_.scene.bounds_min_m - margin, scenario_.scene.bounds_max_m + margin).added;
@@ -166,8 +170,8 @@ int OnlinePlanning::rateClass(const Scenario& from_here, OnlinePlan* record) {
   IncrementalMapper::Built rated = planningSnapshot();
   record->prior_landmarks = addPrior(&rated.map);
   record->snapshot_s += secondsSince(t0);
-  const PlanRun choice = runPlanner(from_here, rated.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
-                                    cfg_.unknown_space == UnknownSpace::kFree);
+  const PlanRun choice = solvePlan(from_here, rated.map, planner_, seed_, rrt_samples_, "planner.oracle_class",
+                                   cfg_.unknown_space == UnknownSpace::kFree);
   record->voxel_map_s += choice.voxel_map_s;
   record->solve_s += choice.solve_s;
   record->rated_class = choice.plan.chosen_class;

@@ -166,6 +166,8 @@ class OnlinePlanning {
   // The map a plan is made on: a snapshot, with the places planned from and the goal free
   // (unknown_space blocked) and the guard's wedges blocked.
   IncrementalMapper::Built planningSnapshot();
+  // The robot radius and two voxels of `map`: the clearance kept around visited places and paths.
+  double clearOf(const planner::FeatureMap& map) const;
   // Adds trial.unseen_prior's mean landmarks to `map` (unseen_prior.h); returns how many.
   int addPrior(planner::FeatureMap* map) const;
   // unseen_prior route_mean: the homology class the proposed planner chooses from `from_here` on a

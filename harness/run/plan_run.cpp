@@ -97,8 +97,8 @@ void buildPlanningVoxels(const Scenario& scenario, const planner::FeatureMap& ma
   run->voxel_map_s = secondsSince(t0);
 }
 
-PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
-                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option, bool unknown_free) {
+PlanRun solvePlan(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
+                  std::uint64_t seed, int rrt_samples, const std::string& oracle_option, bool unknown_free) {
   PlanRun run;
   run.planner = kind;
   run.seed = seed;
@@ -131,6 +131,12 @@ PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, pla
                      ": out of range: " + scenario.scene.source.stem().string() + " has " + std::to_string(classes) +
                      " homology classes (0.." + std::to_string(classes - 1) + ")");
   }
+  return run;
+}
+
+PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind kind,
+                   std::uint64_t seed, int rrt_samples, const std::string& oracle_option, bool unknown_free) {
+  PlanRun run = solvePlan(scenario, map, kind, seed, rrt_samples, oracle_option, unknown_free);
   makeTrajectory(scenario, &run);
   return run;
 }

@@ -65,6 +65,10 @@ void applyOracleClass(int k, planner::PlannerKind planner, Scenario* scenario);
 PlanRun runPlanner(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind name,
                    std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class",
                    bool unknown_free = false);
+// runPlanner without the trajectory (run.trajectory left empty): where only the plan is wanted.
+PlanRun solvePlan(const Scenario& scenario, const planner::FeatureMap& map, planner::PlannerKind name,
+                  std::uint64_t seed, int rrt_samples, const std::string& oracle_option = "planner.oracle_class",
+                  bool unknown_free = false);
 
 nlohmann::ordered_json planJson(const Scenario& scenario, const PlanRun& run);
 // A run's config.yaml: "# tgnav COMMAND --planner P [--samples N] --seed S [--class K]", then the
