@@ -1,6 +1,7 @@
 #include "harness/run/frame_prediction.h"
 
 #include <cmath>
+#include <stdexcept>
 
 namespace tgnav::harness {
 
@@ -22,6 +23,38 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   const planner::Matrix6d info = planner::poseInformation(p, yaw, points, visibility, information, &out.support);
   out.score = planner::scoreInformation(info, out.support, information);
   if (information.model) out.track_probability = information.model->probability(out.support);
+  return out;
+}
+
+Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WB, double yaw_rad) {
+  // Optical frame: z forward (along yaw), y down, x right.
+  const Eigen::Vector3d forward(std::cos(yaw_rad), std::sin(yaw_rad), 0.0);
+  const Eigen::Vector3d down(0.0, 0.0, -1.0);
+  Eigen::Matrix3d R;
+  R.col(0) = down.cross(forward);
+  R.col(1) = down;
+  R.col(2) = forward;
+  Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
+  X_WC.linear() = R;
+  X_WC.translation() = p_WB;
+  return X_WC;
+}
+
+RatedView worstView(const control::SetpointTrajectory& trajectory, double tau_from, double span_s, double step_s,
+                    const planner::VoxelMap& voxels, const planner::VisibilityConfig& visibility,
+                    const planner::InformationConfig& information) {
+  if (!(step_s > 0.0) || !(span_s >= 0.0)) throw std::invalid_argument("worstView: step_s > 0 and span_s >= 0");
+  const auto worse = [](const FramePrediction& a, const FramePrediction& b) {
+    return a.track_probability >= 0.0 ? a.track_probability < b.track_probability : a.score < b.score;
+  };
+  RatedView out;
+  const int steps = static_cast<int>(std::floor(span_s / step_s + 1e-9));
+  for (int i = 0; i <= steps; ++i) {
+    const double tau = tau_from + i * step_s;
+    const control::TrajectorySetpoint sp = trajectory.sample(tau);
+    const FramePrediction f = predictFrame(voxels, levelCamera(sp.p_WB, sp.yaw_rad), visibility, information);
+    if (i == 0 || worse(f, out.prediction)) out = RatedView{tau, sp.yaw_rad, f};
+  }
   return out;
 }
 

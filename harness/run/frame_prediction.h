@@ -5,6 +5,7 @@
 #include <ostream>
 #include <vector>
 
+#include "control/trajectory.h"
 #include "planner/perception.h"
 #include "planner/voxel_map.h"
 
@@ -26,6 +27,24 @@ struct FramePrediction {
 FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isometry3d& X_WC,
                              const planner::VisibilityConfig& visibility,
                              const planner::InformationConfig& information);
+
+// The camera pose the model rates for a body at p_WB with its optical axis along yaw_rad, level
+// (the planners' view of a Pose4: the camera at the body's place).
+Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WB, double yaw_rad);
+
+// The least trackable view a trajectory flies between tau_from and tau_from + span_s (its own time
+// base), rated on the planners' voxel map every step_s (both ends included) at the setpoints' place
+// and yaw: the view with the least track probability (with a model), else the least score. Online,
+// each plan rates the views the vehicle will fly after it, which the look-ahead may have turned
+// away from the plan's own (OnlinePlan::flown_*).
+struct RatedView {
+  double tau = 0.0;  // when, on the trajectory's time base
+  double yaw_rad = 0.0;
+  FramePrediction prediction;
+};
+RatedView worstView(const control::SetpointTrajectory& trajectory, double tau_from, double span_s, double step_s,
+                    const planner::VoxelMap& voxels, const planner::VisibilityConfig& visibility,
+                    const planner::InformationConfig& information);
 
 // vo.csv's columns of a prediction (`tgnav views` writes the same), and one frame's values in
 // them: comma-separated, no leading or trailing comma; the probability is empty without a model.

@@ -81,6 +81,18 @@ struct OnlinePlan {
   // trial.unseen_prior route_mean: the class the plan on the map with the mean prior chose, which
   // this plan then flies (-1: none, or not asked)
   int rated_class = -1;
+  // A flown plan (adopted, or its views renewed): the least trackable view the vehicle then flies
+  // until the next plan can take effect (its switch + replan_period_s), as this plan's map rates it
+  // (worstView, frame_prediction.h, every kFlownViewStepS at the setpoints). The look-ahead and the
+  // splice may fly views the plan did not choose: own_min_p is the least probability of the plan's
+  // own views over the same time (its trajectory before the look-ahead; with the views renewed, the
+  // route's positions with the plan's yaws), asked only where the flown one is blind (below
+  // planner.information.min_track_probability). -1: not asked (not flown, no voxel map, no model).
+  double flown_min_p = -1.0;
+  double flown_min_at_s = -1.0;  // simulated time of that view
+  double flown_min_yaw_rad = 0.0;
+  double flown_min_detections = -1.0;  // its expected detections (planner::ViewSupport::detections)
+  double own_min_p = -1.0;
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
   double voxel_map_s = 0.0;  // wall clock
   double solve_s = 0.0;
@@ -202,7 +214,16 @@ class OnlinePlanning {
   // Blind lengths this close count as equal (planner.selection.blind_tolerance_m).
   double holdRate() const { return scenario_.planner.trajectory.sample_rate_hz; }
   double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }
-  void renewViews(const Attempt& a, double tau_switch);
+  // Flies a (a plan with a trajectory) from tau_switch, simulated time t_switch, on.
+  void adopt(Attempt* a, double tau_switch, double t_switch, bool before_start);
+  // Renews the views ahead with a's (renewedViews, then the look-ahead), and returns the renewed
+  // trajectory before the look-ahead: the plan's own views along the route (nothing: not renewed).
+  std::optional<control::SetpointTrajectory> renewViews(const Attempt& a, double tau_switch);
+  // a's record's flown_* (and own_min_p from `own`, its time base's start at tau_switch when
+  // own_from_start): the current trajectory's views from tau_switch on, which is simulated time
+  // t_switch.
+  void rateFlownViews(const control::SetpointTrajectory* own, bool own_from_start, double tau_switch, double t_switch,
+                      Attempt* a) const;
   // The current trajectory becomes `next` from tau_switch on (spliceTrajectory), its yaw rate
   // then held within the trajectory's limit (limitYawRate).
   void switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s);

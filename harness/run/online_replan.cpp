@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "harness/run/frame_prediction.h"
 #include "harness/run/look_ahead.h"
 #include "harness/run/online_planning.h"
 #include "harness/run/view_guard.h"
@@ -20,6 +21,9 @@ constexpr int kMaxFailedPlans = 3;
 // follows the current route: it is not flown (a switch starts from rest). Yaw is not compared:
 // where the way ahead is unknown it follows the motion (trial.look_ahead_s), not the planner.
 constexpr double kSameRouteM = 0.75;
+// A flown plan's views are rated this often (OnlinePlan::flown_min_p): twice per camera frame
+// period at the default 20 Hz would double the cost for views 2.5 cm apart at the nominal speed.
+constexpr double kFlownViewStepS = 0.1;
 
 // Whether every pose of `path` lies within kSameRouteM (horizontally) of some point of `ahead`.
 bool followsRoute(const std::vector<planner::Pose4>& path, const std::vector<Eigen::Vector3d>& ahead) {
@@ -58,10 +62,31 @@ void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahea
   }
 }
 
-void OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
-  const std::optional<control::SetpointTrajectory> renewed =
+std::optional<control::SetpointTrajectory> OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
+  std::optional<control::SetpointTrajectory> renewed =
       renewedViews(*current_, *a.raw, tau_switch, scenario_.planner.trajectory.max_yaw_rate_rad_s);
   if (renewed) switchTo(a.look ? *renewed : lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  return renewed;
+}
+
+void OnlinePlanning::rateFlownViews(const control::SetpointTrajectory* own, bool own_from_start, double tau_switch,
+                                    double t_switch, Attempt* a) const {
+  if (!a->run.voxels) return;
+  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
+  const RatedView flown = worstView(*current_, tau_switch, cfg_.replan_period_s, kFlownViewStepS, *a->run.voxels,
+                                    perception.visibility, perception.information);
+  const double p = flown.prediction.track_probability;
+  if (p < 0.0) return;  // no model
+  OnlinePlan& r = a->record;
+  r.flown_min_p = p;
+  r.flown_min_at_s = t_switch + (flown.tau - tau_switch);
+  r.flown_min_yaw_rad = flown.yaw_rad;
+  r.flown_min_detections = flown.prediction.support.detections;
+  if (own == nullptr || p >= perception.information.min_track_probability) return;
+  const double from = own_from_start ? own->startTime() : tau_switch;
+  r.own_min_p = worstView(*own, from, cfg_.replan_period_s, kFlownViewStepS, *a->run.voxels, perception.visibility,
+                          perception.information)
+                    .prediction.track_probability;
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {
@@ -96,6 +121,19 @@ std::string OnlinePlanning::takeTrigger() {
   const char* why = blind_view_ ? "blind_view" : blocked_ ? "blocked" : goal_event_ ? "goal_seen" : "period";
   blind_view_ = blocked_ = goal_event_ = false;
   return why;
+}
+
+void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool before_start) {
+  a->record.adopted = true;
+  stops_short_ = a->stops_short;
+  if (a->look) looked_.push_back(*a->look);
+  last_change_s_ = a->record.t_s;
+  switchTo(*a->trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
+  rateFlownViews(a->raw ? &*a->raw : nullptr, true, tau_switch, t_switch, a);
+  failed_in_a_row_ = 0;
+  holding_ = false;
+  if (guard_) guard_->rearm();
+  result_.plans.push_back(std::move(a->record));
 }
 
 std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
@@ -140,7 +178,8 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   if (a.trajectory && !must_switch && (committed || same || keep)) {
     failed_in_a_row_ = 0;
     if (renew && same) {
-      renewViews(a, tau_switch);
+      const std::optional<control::SetpointTrajectory> own = renewViews(a, tau_switch);
+      rateFlownViews(own ? &*own : nullptr, false, tau_switch, t_eff, &a);
       a.record.views_renewed = true;
       pending_until_s_ = t_eff;
     }
@@ -148,16 +187,8 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     return std::string();
   }
   if (a.trajectory) {
-    a.record.adopted = true;
-    stops_short_ = a.stops_short;
-    if (a.look) looked_.push_back(*a.look);
-    last_change_s_ = t_s;
-    switchTo(*a.trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
+    adopt(&a, tau_switch, before_start ? trajectory_start_s : t_eff, before_start);
     pending_until_s_ = t_eff;
-    failed_in_a_row_ = 0;
-    holding_ = false;
-    if (guard_) guard_->rearm();
-    result_.plans.push_back(std::move(a.record));
     return std::string();
   }
   result_.plans.push_back(a.record);

@@ -221,6 +221,11 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;
     j["rated_class"] = p.rated_class;
+    j["flown_min_p"] = p.flown_min_p;
+    j["flown_min_at_s"] = p.flown_min_at_s;
+    j["flown_min_yaw_rad"] = p.flown_min_yaw_rad;
+    j["flown_min_detections"] = p.flown_min_detections;
+    j["own_min_p"] = p.own_min_p;
     nlohmann::ordered_json path = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < p.path.size(); ++i) {
       path.push_back({p.path[i].x(), p.path[i].y(), p.path[i].z(), p.path_unknown[i] ? 1 : 0});

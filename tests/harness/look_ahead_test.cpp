@@ -7,16 +7,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
+#include "harness/run/frame_prediction.h"
 #include "harness/run/incremental_map.h"
 #include "harness/run/online_planning.h"
 #include "harness/run/unseen_prior.h"
 #include "planner/feature_map.h"
 #include "planner/perception.h"
+#include "planner/track_model.h"
 #include "planner/voxel_map.h"
 #include "tests/harness/test_util.h"
 
@@ -206,6 +210,57 @@ TEST(LookAhead, WithARaterTheTrajectoryKeepsItsYawWhereTheWayAheadIsTrackable) {
     EXPECT_GT(plain.sample(at).yaw_rad, -60.0 * kDeg);  // turned toward the way ahead
     EXPECT_DOUBLE_EQ(rated.sample(at).yaw_rad, plain.sample(at).yaw_rad);
   }
+}
+
+TEST(LevelCamera, LooksAlongTheYawWithTheImageUpright) {
+  const Eigen::Isometry3d X_WC = levelCamera(Eigen::Vector3d(1.0, 2.0, 1.5), 90.0 * kDeg);
+  EXPECT_TRUE(X_WC.linear().col(2).isApprox(Eigen::Vector3d::UnitY(), 1e-12));   // optical axis: north
+  EXPECT_TRUE(X_WC.linear().col(1).isApprox(-Eigen::Vector3d::UnitZ(), 1e-12));  // image y: down
+  EXPECT_TRUE(X_WC.linear().col(0).isApprox(Eigen::Vector3d::UnitX(), 1e-12));   // image x: right (east)
+  EXPECT_TRUE(X_WC.translation().isApprox(Eigen::Vector3d(1.0, 2.0, 1.5)));
+  EXPECT_NEAR(X_WC.linear().determinant(), 1.0, 1e-12);
+}
+
+// A hovering camera 1.75 m in front of the textured wall turns from it (east, yaw 0) to the north
+// (nothing known there) over 2 s, then holds. worstView finds the view the vehicle would lose the
+// VO in, at the model's rating, within the span asked and not after it.
+TEST(WorstView, FindsTheLeastTrackableViewOfTheSpanAtTheModelsRating) {
+  WallViews wall;
+  planner::TrackModel model;
+  model.terms.push_back({planner::TrackFeature::kLogDetections, std::log1p(50.0), 0.5, 2.0});
+  wall.information.model = std::make_shared<const planner::TrackModel>(model);
+  const control::SetpointTrajectory turn = [] {
+    std::vector<double> t;
+    std::vector<control::TrajectorySetpoint> sp;
+    for (int i = 0; i <= 400; ++i) {
+      t.push_back(i * 0.01);
+      control::TrajectorySetpoint s;
+      s.p_WB = Eigen::Vector3d(1.75, 0.0, 1.0);
+      s.yaw_rad = std::min(1.0, i * 0.01 / 2.0) * 90.0 * kDeg;
+      sp.push_back(s);
+    }
+    return control::SetpointTrajectory(t, sp);
+  }();
+  const auto rate = [&](double from, double span) {
+    return worstView(turn, from, span, 0.1, wall.voxels, wall.visibility, wall.information);
+  };
+  // Facing the wall it tracks; facing north it does not: the worst view is the turn's end.
+  const RatedView start = rate(0.0, 0.0);
+  ASSERT_GT(start.prediction.track_probability, 0.9);
+  const RatedView whole = rate(0.0, 3.0);
+  EXPECT_LT(whole.prediction.track_probability, 0.1);
+  EXPECT_GE(whole.tau, 1.4);
+  EXPECT_LE(whole.tau, 3.0 + 1e-9);
+  EXPECT_DOUBLE_EQ(whole.yaw_rad, turn.sample(whole.tau).yaw_rad);
+  // No view of the span is worse than the one returned.
+  for (double tau = 0.0; tau <= 3.0 + 1e-9; tau += 0.1) {
+    const FramePrediction f = predictFrame(wall.voxels, levelCamera(turn.sample(tau).p_WB, turn.sample(tau).yaw_rad),
+                                           wall.visibility, wall.information);
+    EXPECT_GE(f.track_probability, whole.prediction.track_probability);
+  }
+  // The first half second of the turn (22.5 deg) keeps the wall in view: the span bounds the search.
+  EXPECT_GT(rate(0.0, 0.5).prediction.track_probability, 0.9);
+  EXPECT_THROW(rate(0.0, -1.0), std::invalid_argument);
 }
 
 TEST(StopBeforeUnknown, EndsBeforeThePathComesNearUnobservedSpaceAndLooksAtTheWayOn) {

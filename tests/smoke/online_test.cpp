@@ -80,6 +80,27 @@ TEST(OnlineTrial, FromNoMapFliesMapsAndReplansTheSameWhateverTheThreads) {
   ASSERT_EQ(static_cast<int>(plans.size()), o["plans"].get<int>());
   EXPECT_EQ(plans[0]["trigger"], "start");
   EXPECT_EQ(plans[0]["landmarks"], 0);  // no prior map
+  // Each plan flown in flight rates the views the vehicle then flies, over the replan period, on
+  // its map (OnlinePlan::flown_min_p; the default learned model); a plan not flown rates none.
+  int rated = 0;
+  for (const nlohmann::json& p : plans) {
+    const bool flown = (p["adopted"].get<bool>() || p["views_renewed"].get<bool>()) && p["trigger"] != "start";
+    if (!flown) {
+      EXPECT_EQ(p["flown_min_p"].get<double>(), -1.0);
+      continue;
+    }
+    ++rated;
+    EXPECT_GE(p["flown_min_p"].get<double>(), 0.0);
+    EXPECT_LE(p["flown_min_p"].get<double>(), 1.0);
+    EXPECT_GE(p["flown_min_at_s"].get<double>(), p["effective_s"].get<double>() - 1e-9);
+    // In flight the views rated start at the switch (before take-off: where the trajectory starts).
+    if (p["t_s"].get<double>() > 5.0) {
+      EXPECT_LE(p["flown_min_at_s"].get<double>(), p["effective_s"].get<double>() + 2.0 + 1e-9);
+    }
+    // The plan's own views are rated only where the flown ones are blind.
+    EXPECT_EQ(p["own_min_p"].get<double>() >= 0.0, p["flown_min_p"].get<double>() < 0.35);
+  }
+  EXPECT_GE(rated, 1);
 }
 
 TEST(OnlineTrial, MapsAtTheTruePoseOnGroundTruthAndPlansFirstOnASurveyPrior) {
