@@ -137,8 +137,10 @@ def analyse(folder, threshold):
         else:
             _, _, p = loss_window
             blind = p['flown_min_p'] < threshold and p['flown_min_at_s'] <= lost + 0.5
-            if not blind:
+            if p['flown_min_p'] >= threshold:
                 why = 'rated trackable'
+            elif not blind:
+                why = 'its worst view after the loss'  # the views at the loss not known (only the worst is kept)
             elif p['own_min_p'] >= threshold:
                 why = 'rated blind: turned by the look-ahead or splice'
             else:

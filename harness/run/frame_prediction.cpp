@@ -26,7 +26,7 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
   return out;
 }
 
-Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WB, double yaw_rad) {
+Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WC, double yaw_rad) {
   // Optical frame: z forward (along yaw), y down, x right.
   const Eigen::Vector3d forward(std::cos(yaw_rad), std::sin(yaw_rad), 0.0);
   const Eigen::Vector3d down(0.0, 0.0, -1.0);
@@ -36,7 +36,7 @@ Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WB, double yaw_rad) {
   R.col(2) = forward;
   Eigen::Isometry3d X_WC = Eigen::Isometry3d::Identity();
   X_WC.linear() = R;
-  X_WC.translation() = p_WB;
+  X_WC.translation() = p_WC;
   return X_WC;
 }
 
@@ -52,7 +52,8 @@ RatedView worstView(const control::SetpointTrajectory& trajectory, double tau_fr
   for (int i = 0; i <= steps; ++i) {
     const double tau = tau_from + i * step_s;
     const control::TrajectorySetpoint sp = trajectory.sample(tau);
-    const FramePrediction f = predictFrame(voxels, levelCamera(sp.p_WB, sp.yaw_rad), visibility, information);
+    const Eigen::Vector3d p_WC = planner::cameraPosition(sp.p_WB, sp.yaw_rad, visibility);
+    const FramePrediction f = predictFrame(voxels, levelCamera(p_WC, sp.yaw_rad), visibility, information);
     if (i == 0 || worse(f, out.prediction)) out = RatedView{tau, sp.yaw_rad, f};
   }
   return out;

@@ -28,14 +28,14 @@ FramePrediction predictFrame(const planner::VoxelMap& voxels, const Eigen::Isome
                              const planner::VisibilityConfig& visibility,
                              const planner::InformationConfig& information);
 
-// The camera pose the model rates for a body at p_WB with its optical axis along yaw_rad, level
-// (the planners' view of a Pose4: the camera at the body's place).
-Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WB, double yaw_rad);
+// A level camera at p_WC with its optical axis along yaw_rad (the planners' view of a Pose4, the
+// camera at planner::cameraPosition of the body).
+Eigen::Isometry3d levelCamera(const Eigen::Vector3d& p_WC, double yaw_rad);
 
 // The least trackable view a trajectory flies between tau_from and tau_from + span_s (its own time
 // base), rated on the planners' voxel map every step_s (both ends included) at the setpoints' place
-// and yaw: the view with the least track probability (with a model), else the least score. Online,
-// each plan rates the views the vehicle will fly after it, which the look-ahead may have turned
+// (the camera's, planner::cameraPosition) and yaw: the view with the least track probability (with a model), else the
+// least score. Online, each plan rates the views the vehicle will fly after it, which the look-ahead may have turned
 // away from the plan's own (OnlinePlan::flown_*).
 struct RatedView {
   double tau = 0.0;  // when, on the trajectory's time base

@@ -70,6 +70,8 @@ class FlownViews(unittest.TestCase):
         write_trial(self.root, "b", [plan(0.0, 0.9, 1.0), plan(2.0, 0.1, 2.8, own_p=0.1)], lost=3.0)
         # c: lost at 3.0 where the plan in force rated every view trackable.
         write_trial(self.root, "c", [plan(2.0, 0.8, 2.6)], lost=3.0)
+        # e: lost at 3.0, the window's worst view (blind) at 4.0, after the loss.
+        write_trial(self.root, "e", [plan(2.0, 0.1, 4.0, own_p=0.1)], lost=3.0)
         # d: no loss; two windows rated blind, one of whose worst view a later plan replaced first.
         write_trial(self.root, "d", [plan(0.0, 0.2, 1.0, own_p=0.9), plan(2.0, 0.1, 6.0, own_p=0.9), plan(4.0, 0.9, 5.0),
                                      plan(6.0, 0.5, 6.6, flown=False)], inliers=444)
@@ -82,6 +84,7 @@ class FlownViews(unittest.TestCase):
         self.assertEqual(rows["b"]["attribution"], "rated blind: the plan's own views")
         self.assertEqual(rows["c"]["attribution"], "rated trackable")
         self.assertEqual(rows["d"]["attribution"], "")
+        self.assertEqual(rows["e"]["attribution"], "its worst view after the loss")
         # a: the windows before the loss's (0.5-2.5, 2.5-4.5), one rated blind.
         self.assertEqual(int(rows["a"]["windows_passed"]), 2)
         self.assertEqual(int(rows["a"]["windows_passed_rated_blind"]), 1)
