@@ -173,13 +173,6 @@ struct OnlineConfig {
   // 0: by the inliers alone (docs/results/guard: it tripped 0.15 s before the loss). Measured at
   // 0.6 s and left off: storage never lost the VO, but 8 of 10 flights stalled (docs/results/lead).
   double guard_lead_s = 0.0;
-  // > 0: the look-ahead's blind turns foreseen (harness/run/online_replan.cpp). Where a plan flown
-  // in flight would fly, before the next plan, a view its own map gives a track probability below
-  // this (OnlinePlan::flown_min_p), at a place the plan's own yaw keeps above it (the look-ahead
-  // turned the camera toward unknown space there), the vehicle stops 0.5 s before that view, and
-  // the plans from then on take the unknown space it would have looked at, within guard_range_m, as
-  // occupied. 0: off. Measured at 0.1 (docs/results/flown_views).
-  double stop_before_blind_look = 0.0;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
   // Depth within this range goes into the map, and the features there become landmarks: the
@@ -223,7 +216,6 @@ struct OnlineConfig {
     a("guard_inliers", guard_inliers);
     a("guard_range_m", guard_range_m);
     a("guard_lead_s", guard_lead_s);
-    a("stop_before_blind_look", stop_before_blind_look);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("map_range_m", map_range_m);

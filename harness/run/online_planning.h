@@ -93,11 +93,6 @@ struct OnlinePlan {
   double flown_min_yaw_rad = 0.0;
   double flown_min_detections = -1.0;  // its expected detections (planner::ViewSupport::detections)
   double own_min_p = -1.0;
-  // trial.stop_before_blind_look: the look-ahead's blind view this plan stopped the vehicle before
-  // (simulated time; -1: none), and the unknown space it would have looked at, planned as occupied
-  // from then on.
-  double blind_look_s = -1.0;
-  std::optional<BlindWedge> blind_look_wedge;
   double snapshot_s = 0.0;   // wall clock: the map snapshot (copy, opportunities, embedding)
   double voxel_map_s = 0.0;  // wall clock
   double solve_s = 0.0;
@@ -219,12 +214,6 @@ class OnlinePlanning {
   // Blind lengths this close count as equal (planner.selection.blind_tolerance_m).
   double holdRate() const { return scenario_.planner.trajectory.sample_rate_hz; }
   double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }
-  // trial.stop_before_blind_look: where the current trajectory, from tau_switch (simulated time
-  // t_switch) to the next plan, turns to a view a's map rates below the threshold at a place `own`
-  // (a's views before the look-ahead; own_from_start as in rateFlownViews) keeps above it, the
-  // vehicle holds 0.5 s before it, that view's unknown space becomes a wedge and a plan is asked.
-  void stopBeforeBlindLook(const control::SetpointTrajectory* own, bool own_from_start, double tau_switch,
-                           double t_switch, Attempt* a);
   // Flies a (a plan with a trajectory) from tau_switch, simulated time t_switch, on.
   void adopt(Attempt* a, double tau_switch, double t_switch, bool before_start);
   // Renews the views ahead with a's (renewedViews, then the look-ahead), and returns the renewed

@@ -24,10 +24,6 @@ constexpr double kSameRouteM = 0.75;
 // A flown plan's views are rated this often (OnlinePlan::flown_min_p): twice per camera frame
 // period at the default 20 Hz would double the cost for views 2.5 cm apart at the nominal speed.
 constexpr double kFlownViewStepS = 0.1;
-// trial.stop_before_blind_look: the vehicle holds this long before the blind view (at the nominal
-// 0.4 m/s, 0.2 m), over a blend as short as the guard's.
-constexpr double kBlindLookLeadS = 0.5;
-constexpr double kStopBlendS = 0.3;
 
 // Whether every pose of `path` lies within kSameRouteM (horizontally) of some point of `ahead`.
 bool followsRoute(const std::vector<planner::Pose4>& path, const std::vector<Eigen::Vector3d>& ahead) {
@@ -127,42 +123,6 @@ std::string OnlinePlanning::takeTrigger() {
   return why;
 }
 
-void OnlinePlanning::stopBeforeBlindLook(const control::SetpointTrajectory* own, bool own_from_start, double tau_switch,
-                                         double t_switch, Attempt* a) {
-  const double floor = cfg_.stop_before_blind_look;
-  if (floor <= 0.0 || own == nullptr || !a->run.voxels) return;
-  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
-  const auto rate = [&](const control::SetpointTrajectory& traj, double tau) {
-    const control::TrajectorySetpoint sp = traj.sample(tau);
-    const Eigen::Vector3d p_WC = planner::cameraPosition(sp.p_WB, sp.yaw_rad, perception.visibility);
-    return predictFrame(*a->run.voxels, levelCamera(p_WC, sp.yaw_rad), perception.visibility, perception.information)
-        .track_probability;
-  };
-  if (rate(*current_, tau_switch) < floor) return;  // blind already: a stop saves nothing
-  const int steps = static_cast<int>(std::floor(cfg_.replan_period_s / kFlownViewStepS + 1e-9));
-  for (int i = 1; i <= steps; ++i) {
-    const double tau_b = tau_switch + i * kFlownViewStepS;
-    if (rate(*current_, tau_b) >= floor) continue;
-    const double tau_own = own_from_start ? own->startTime() + (tau_b - tau_switch) : tau_b;
-    if (rate(*own, tau_own) < floor) return;  // the plan's own view: not the look-ahead's turn
-    const control::TrajectorySetpoint blind = current_->sample(tau_b);
-    const double half_fov = 0.5 * perception.visibility.hfov_rad;
-    const BlindWedge wedge{blind.p_WB, blind.yaw_rad - half_fov, 2.0 * half_fov, cfg_.guard_range_m};
-    wedges_.push_back(wedge);
-    const double tau_hold = std::max(tau_switch, tau_b - kBlindLookLeadS);
-    const control::TrajectorySetpoint hold = current_->sample(tau_hold);
-    switchTo(holdTrajectory(planner::Pose4{hold.p_WB, hold.yaw_rad}, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s,
-                            holdRate()),
-             tau_hold, kStopBlendS);
-    a->record.blind_look_s = t_switch + (tau_b - tau_switch);
-    a->record.blind_look_wedge = wedge;
-    holding_ = true;
-    stops_short_ = false;
-    blind_view_ = true;  // asks a plan as soon as this one has taken effect
-    return;
-  }
-}
-
 void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool before_start) {
   a->record.adopted = true;
   stops_short_ = a->stops_short;
@@ -172,7 +132,6 @@ void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool 
   rateFlownViews(a->raw ? &*a->raw : nullptr, true, tau_switch, t_switch, a);
   failed_in_a_row_ = 0;
   holding_ = false;
-  if (!before_start) stopBeforeBlindLook(a->raw ? &*a->raw : nullptr, true, tau_switch, t_switch, a);
   if (guard_) guard_->rearm();
   result_.plans.push_back(std::move(a->record));
 }
@@ -221,7 +180,6 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     if (renew && same) {
       const std::optional<control::SetpointTrajectory> own = renewViews(a, tau_switch);
       rateFlownViews(own ? &*own : nullptr, false, tau_switch, t_eff, &a);
-      stopBeforeBlindLook(own ? &*own : nullptr, false, tau_switch, t_eff, &a);
       a.record.views_renewed = true;
       pending_until_s_ = t_eff;
     }

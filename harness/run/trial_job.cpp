@@ -226,16 +226,6 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["flown_min_yaw_rad"] = p.flown_min_yaw_rad;
     j["flown_min_detections"] = p.flown_min_detections;
     j["own_min_p"] = p.own_min_p;
-    j["blind_look_s"] = p.blind_look_s;
-    if (p.blind_look_wedge) {
-      const BlindWedge& w = *p.blind_look_wedge;
-      j["blind_look_wedge"] = {{"p", {w.apex.x(), w.apex.y(), w.apex.z()}},
-                               {"from_rad", w.from_rad},
-                               {"width_rad", w.width_rad},
-                               {"range_m", w.range_m}};
-    } else {
-      j["blind_look_wedge"] = nullptr;
-    }
     nlohmann::ordered_json path = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < p.path.size(); ++i) {
       path.push_back({p.path[i].x(), p.path[i].y(), p.path[i].z(), p.path_unknown[i] ? 1 : 0});
