@@ -104,6 +104,21 @@ def windows(plans, period):
     return out
 
 
+def foreseen(p, lost, threshold):
+    """Whether plan p rated a view blind at or before the loss (0.5 s: a frame or so after it)."""
+    return p['flown_min_p'] < threshold and p['flown_min_at_s'] <= lost + 0.5
+
+
+def attribution(p, lost, threshold):
+    if p['flown_min_p'] >= threshold:
+        return 'rated trackable'
+    if not foreseen(p, lost, threshold):
+        return 'its worst view after the loss'  # the views at the loss not known (only the worst is kept)
+    if p['own_min_p'] >= threshold:
+        return 'rated blind: turned by the look-ahead or splice'
+    return "rated blind: the plan's own views"
+
+
 def analyse(folder, threshold):
     m = read_json(os.path.join(folder, 'metrics.json'))
     if m.get('mode') != 'online':
@@ -120,35 +135,22 @@ def analyse(folder, threshold):
     row = {'trial': os.path.basename(folder.rstrip('/')), 'planner': m.get('planner', ''), 'scene': m.get('scene', ''),
            'status': m.get('status', ''), 'vo_lost_at_s': '' if lost is None else lost}
     passed = []  # (window's worst p, VO inliers at that view) for windows the VO came through
-    loss_window = None
+    in_force = None  # the plan whose window holds the loss
     for start, end, p in windows(plans, period):
-        if lost is not None and start <= lost:
-            if lost < end + 1e-9:
-                loss_window = (start, end, p)
-                continue
-        if lost is not None and end > lost:
+        if lost is not None and lost < end + 1e-9:
+            if start <= lost:
+                in_force = p
             continue
         if p['flown_min_at_s'] > end + 1e-9:
             continue  # replaced before that view was flown
         passed.append((p['flown_min_p'], at(times, inliers, p['flown_min_at_s'])))
+    row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='')
     if lost is not None:
-        if loss_window is None:
-            row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='no rated plan')
-        else:
-            _, _, p = loss_window
-            blind = p['flown_min_p'] < threshold and p['flown_min_at_s'] <= lost + 0.5
-            if p['flown_min_p'] >= threshold:
-                why = 'rated trackable'
-            elif not blind:
-                why = 'its worst view after the loss'  # the views at the loss not known (only the worst is kept)
-            elif p['own_min_p'] >= threshold:
-                why = 'rated blind: turned by the look-ahead or splice'
-            else:
-                why = "rated blind: the plan's own views"
-            row.update(loss_plan_s=p['t_s'], flown_min_p=p['flown_min_p'], flown_min_at_s=p['flown_min_at_s'],
-                       own_min_p=p['own_min_p'], attribution=why)
-    else:
-        row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='')
+        row['attribution'] = 'no rated plan'
+    if lost is not None and in_force is not None:
+        p = in_force
+        row.update(loss_plan_s=p['t_s'], flown_min_p=p['flown_min_p'], flown_min_at_s=p['flown_min_at_s'],
+                   own_min_p=p['own_min_p'], attribution=attribution(p, lost, threshold))
     row['windows_passed'] = len(passed)
     row['windows_passed_rated_blind'] = sum(1 for q, _ in passed if q < threshold)
     return row, passed
@@ -192,8 +194,7 @@ def main(argv):
         # Were the plans to stop short of every view rated below a threshold: the losses that would
         # have been foreseen, against the windows the VO came through that would have been stopped.
         for t in THRESHOLDS:
-            seen = sum(1 for r in losses if r['flown_min_p'] != '' and r['flown_min_p'] < t
-                       and r['flown_min_at_s'] <= r['vo_lost_at_s'] + 0.5)
+            seen = sum(1 for r in losses if r['flown_min_p'] != '' and foreseen(r, r['vo_lost_at_s'], t))
             alarms = sum(1 for q, _ in ps if q < t)
             print(f'  below {t:g}: {seen} of {len(losses)} losses foreseen; {alarms} of the {len(ps)} windows the VO came through rated so too')
     return 0
