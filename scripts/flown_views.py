@@ -11,6 +11,9 @@ a window was rated blind anyway (the rating's false alarms).
 
 A window is [effective_s, the next rated plan's effective_s or effective_s + replan_period_s]; its
 worst view counts only if it lies inside the window (a later plan replaced the views after it).
+A plan made on a map with no landmarks (from no map, the plan before take-off) rates every view
+blind: a loss in its window says 'nothing mapped yet', and its window is not counted among those
+the VO came through.
 
 usage: flown_views.py RESULTS... [--out CSV] [--threshold P]
 RESULTS: sweep folders (their trials/*) or trial folders (metrics.json, online.json, vo.csv).
@@ -110,6 +113,8 @@ def foreseen(p, lost, threshold):
 
 
 def attribution(p, lost, threshold):
+    if p['landmarks'] == 0:
+        return 'rated blind: nothing mapped yet'
     if p['flown_min_p'] >= threshold:
         return 'rated trackable'
     if not foreseen(p, lost, threshold):
@@ -129,6 +134,8 @@ def analyse(folder, threshold):
         raise InputError(f"{folder}/online.json: key 'plans' missing")
     if plans and 'flown_min_p' not in plans[0]:
         raise InputError(f"{folder}/online.json: key 'flown_min_p' missing (flown before the flown views were rated)")
+    if plans and 'landmarks' not in plans[0]:
+        raise InputError(f"{folder}/online.json: key 'landmarks' missing")
     period = replan_period(folder)
     lost = m.get('vo_lost_at_s')
     times, inliers = vo_inliers(folder)
@@ -143,6 +150,8 @@ def analyse(folder, threshold):
             continue
         if p['flown_min_at_s'] > end + 1e-9:
             continue  # replaced before that view was flown
+        if p['landmarks'] == 0:
+            continue  # nothing mapped: every view rates blind
         passed.append((p['flown_min_p'], at(times, inliers, p['flown_min_at_s'])))
     row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='')
     if lost is not None:

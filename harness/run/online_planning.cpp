@@ -6,6 +6,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <stdexcept>
 
 #include "harness/base/clock.h"
 #include "harness/base/errors.h"
@@ -334,6 +335,9 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
     if (a.look) looked_.push_back(*a.look);
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
+    // Its views are rated as every flown plan's; their times count from the trajectory's start
+    // until the take-off's length is known (startFlight).
+    rateFlownViews(a.raw ? &*a.raw : nullptr, true, current_->startTime(), 0.0, &a);
   } else {
     // No route yet, or none to fly yet (hold_first_plan): climb to the flight height and look.
     start.p_WB.z() = scenario_.scene.flight_height_m;
@@ -350,7 +354,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
 
 void OnlinePlanning::makeGuard(const Intrinsics& camera) {
   constexpr double kGuardMinTurnRad = 5.0 * M_PI / 180.0;
-  // Its lead needs the camera (before setCamera() the guard judges by the inliers alone).
+  // Its lead needs the camera (before startFlight() the guard judges by the inliers alone).
   GuardLead lead;
   if (camera.width_px > 0) {
     lead = GuardLead{cfg_.guard_lead_s, camera, static_cast<double>(scenario_.vo.features.edge_threshold_px)};
@@ -359,9 +363,13 @@ void OnlinePlanning::makeGuard(const Intrinsics& camera) {
                  cfg_.guard_range_m, lead);
 }
 
-void OnlinePlanning::setCamera(const Intrinsics& camera) {
+void OnlinePlanning::startFlight(const Intrinsics& camera, double trajectory_start_s) {
+  if (flying_ || result_.plans.empty()) throw std::logic_error("OnlinePlanning::startFlight: once, after firstPlan");
+  flying_ = true;
   mapper_.setCamera(camera);
   if (guard_) makeGuard(camera);
+  OnlinePlan& first = result_.plans.front();
+  if (first.flown_min_at_s >= 0.0) first.flown_min_at_s += trajectory_start_s;
 }
 
 bool OnlinePlanning::blockedAhead(double tau_from) const {

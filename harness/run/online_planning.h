@@ -144,8 +144,10 @@ class OnlinePlanning {
   // replans: it may see one. So it does with trial.hold_first_plan, the plan recorded, not flown.
   control::SetpointTrajectory firstPlan(PlanRun* run);
 
-  // The onboard camera, before the first keyframe (the map's, and the tracking guard's lead).
-  void setCamera(const Intrinsics& camera);
+  // Before the first keyframe: the onboard camera (the map's, and the tracking guard's lead), and
+  // when the trajectory starts (simulated time, after the climb): the first plan's flown views were
+  // rated before that was known, their flown_min_at_s counted from the trajectory's start. Once.
+  void startFlight(const Intrinsics& camera, double trajectory_start_s);
 
   // The trajectory to fly now (its time base is the first trajectory's).
   const control::SetpointTrajectory& trajectory() const { return *current_; }
@@ -249,6 +251,7 @@ class OnlinePlanning {
   bool goal_seen_ = false;                // the goal's voxel has been observed
   bool goal_event_ = false;               // ... by the last keyframe: a plan is due
   bool holding_ = false;                  // flying a hold: no route, or the guard tripped
+  bool flying_ = false;                   // startFlight has been called
   std::optional<ViewGuard> guard_;        // trial.guard_tracking, built-in planners
   std::vector<BlindWedge> wedges_;        // ... where it tripped: unknown space there is planned occupied
   bool blind_view_ = false;               // ... it tripped: a plan is due

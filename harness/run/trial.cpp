@@ -113,7 +113,7 @@ class ClosedLoop {
         reinitialise_(scenario.vo.reinitialise_after_lost),
         vehicle_root_(model_->body_rootid[ids_.body]),
         online_(online) {
-    if (online_ != nullptr) online_->setCamera(camera_.intrinsics());
+    if (online_ != nullptr) online_->startFlight(camera_.intrinsics(), timeline_.trajectory_start_s);
     result_->planned_flight_s = timeline_.end_s;
     result_->X_BC = cameraInBody(model_.get(), camera_.id());
     X_CB_ = result_->X_BC.inverse();

@@ -18,10 +18,10 @@ SCRIPTS_DIR = os.environ.get("TGNAV_SCRIPTS_DIR") or os.path.join(os.path.dirnam
 SCRIPT = os.path.join(os.path.abspath(SCRIPTS_DIR), "flown_views.py")
 
 
-def plan(t, flown_p, at_s, own_p=-1.0, flown=True):
+def plan(t, flown_p, at_s, own_p=-1.0, flown=True, landmarks=100):
     return {"t_s": t, "effective_s": t + 0.5, "adopted": False, "views_renewed": flown,
             "flown_min_p": flown_p if flown else -1.0, "flown_min_at_s": at_s if flown else -1.0,
-            "own_min_p": own_p}
+            "own_min_p": own_p, "landmarks": landmarks}
 
 
 def dump(obj, path):
@@ -93,6 +93,24 @@ class FlownViews(unittest.TestCase):
         self.assertEqual(int(rows["d"]["windows_passed_rated_blind"]), 1)
         self.assertIn("at the loss, the plan in force had rated trackable: 1", r.stdout)
         self.assertIn("windows the VO came through: 5; rated blind anyway: 2", r.stdout)
+
+    def test_a_plan_on_an_empty_map_neither_foresees_nor_false_alarms(self):
+        # f: the plan before take-off, on no map, rates everything blind; the VO came through its
+        # window and was lost in the next plan's. g: lost in the empty map's own window.
+        write_trial(self.root, "f", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0), plan(2.0, 0.9, 3.0)], lost=4.0)
+        write_trial(self.root, "g", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0)], lost=2.0)
+        out = os.path.join(self.root, "fv.csv")
+        r = run(self.root, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rows = self.rows(out)
+        self.assertEqual(rows["f"]["attribution"], "rated trackable")
+        self.assertEqual(int(rows["f"]["windows_passed"]), 0)
+        self.assertEqual(rows["g"]["attribution"], "rated blind: nothing mapped yet")
+        self.assertEqual(int(rows["g"]["windows_passed_rated_blind"]), 0)
+        bad = write_trial(self.root, "h", [{k: v for k, v in plan(0.0, 0.5, 1.0).items() if k != "landmarks"}])
+        r = run(bad)
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("online.json: key 'landmarks' missing", r.stderr)
 
     def test_bad_input_is_one_line_exit_2_and_writes_nothing(self):
         out = os.path.join(self.root, "fv.csv")
