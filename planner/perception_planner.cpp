@@ -81,18 +81,14 @@ std::vector<ScoredSegment> scoreSegments(const std::vector<PathSegment>& segment
 
 // Path length around the chosen poses that score blind (6 ln eps): each layer stands for half the
 // interval to either neighbour.
-double blindLength(const PoseGraphResult& graph, const InformationConfig& information, double horizon_m) {
+double blindLength(const PoseGraphResult& graph, const InformationConfig& information) {
   const double blind = logDetInformation(Matrix6d::Zero(), information.epsilon);
   const std::size_t n = graph.scores.size();
-  const double end = horizon_m > 0.0 ? horizon_m : std::numeric_limits<double>::infinity();
-  // The part of [a, b] (arclength) before the horizon.
-  auto within = [&](double a, double b) { return std::max(0.0, std::min(b, end) - std::min(a, end)); };
   double length = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
     if (graph.scores[j] > blind + 1e-9) continue;
-    const double s = graph.layer_s[j];
-    if (j > 0) length += within(0.5 * (graph.layer_s[j - 1] + s), s);
-    if (j + 1 < n) length += within(s, 0.5 * (s + graph.layer_s[j + 1]));
+    if (j > 0) length += 0.5 * (graph.layer_s[j] - graph.layer_s[j - 1]);
+    if (j + 1 < n) length += 0.5 * (graph.layer_s[j + 1] - graph.layer_s[j]);
   }
   return length;
 }
@@ -137,8 +133,6 @@ void SelectionConfig::validate() const {
           perception_tolerance, "must be finite and >= 0");
   require(blind_tolerance_m >= 0.0 && std::isfinite(blind_tolerance_m), "selection.blind_tolerance_m",
           blind_tolerance_m, "must be finite and >= 0");
-  require(blind_horizon_m >= 0.0 && std::isfinite(blind_horizon_m), "selection.blind_horizon_m", blind_horizon_m,
-          "must be finite and >= 0 (0: the whole path)");
 }
 
 void PerceptionPlannerConfig::validate() const {
@@ -167,11 +161,11 @@ int selectCandidate(std::vector<CandidatePath>& candidates, const SelectionConfi
     if (!c.feasible) continue;
     shortest = std::min(shortest, c.length_m);
     best_c_p_min = std::max(best_c_p_min, c.c_p_min);
-    least_blind = std::min(least_blind, c.near_blind_m);
+    least_blind = std::min(least_blind, c.blind_length_m);
   }
   const bool perception_first = config.perception_first && best_c_p_min < config.c_p_threshold;
   auto least_blind_ones = [&](const CandidatePath& c) {
-    return c.near_blind_m <= least_blind + config.blind_tolerance_m;
+    return c.blind_length_m <= least_blind + config.blind_tolerance_m;
   };
   if (perception_first) {  // the best c_p,min among the classes with the least blind length
     best_c_p_min = -std::numeric_limits<double>::infinity();
@@ -219,8 +213,7 @@ Plan ProposedPlanner::solve(const PlanRequest& request) const {
     c.c_p = detail.graph.c_p;
     c.c_p_min = std::numeric_limits<double>::infinity();
     for (const ScoredSegment& s : c.segments) c.c_p_min = std::min(c.c_p_min, s.c_p);
-    c.blind_length_m = blindLength(detail.graph, config_.information, 0.0);
-    c.near_blind_m = blindLength(detail.graph, config_.information, config_.selection.blind_horizon_m);
+    c.blind_length_m = blindLength(detail.graph, config_.information);
   };
   tbb::task_arena arena(config_.threads > 0 ? config_.threads : tbb::task_arena::automatic);
   // One task per class, longest (slowest) first, so that the threads finish together.

@@ -44,7 +44,6 @@ struct SelectionConfig {
   bool perception_first = true;       // below c_p,thr: rank by c_p,min first (ours, see above)
   double perception_tolerance = 1.0;  // c_p,min this close to the best counts as equal there
   double blind_tolerance_m = 0.5;     // blind length this close to the least counts as equal there
-  double blind_horizon_m = 0.0;       // > 0: the blind length compared is that within this of the start; 0: all
 
   // Names every field once, for the harness's config files (a(key, field); harness/config/yaml_util.h).
   template <typename Archive>
@@ -55,7 +54,6 @@ struct SelectionConfig {
     a("perception_first", perception_first);
     a("perception_tolerance", perception_tolerance);
     a("blind_tolerance_m", blind_tolerance_m);
-    a("blind_horizon_m", blind_horizon_m);
   }
 
   void validate() const;

@@ -36,7 +36,6 @@ struct CandidatePath {
   double c_p = std::numeric_limits<double>::quiet_NaN();      // eq. 8 over the whole path
   double c_p_min = std::numeric_limits<double>::quiet_NaN();  // eq. 10: weakest segment
   double blind_length_m = 0.0;  // path length around the poses that score blind (6 ln eps; proposed only)
-  double near_blind_m = 0.0;    // ... of it within selection.blind_horizon_m of the start (the selection's)
   double cost = std::numeric_limits<double>::quiet_NaN();  // selection cost (eq. 9) or planner's own
   bool feasible = true;                                    // false: no collision-free 4-DoF path in this class
   std::vector<ScoredSegment> segments;

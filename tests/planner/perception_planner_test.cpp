@@ -92,7 +92,6 @@ TEST(SelectCandidate, BelowTheThresholdPerceptionComesFirst) {
   auto blind_for = [&](double length_m, double blind_m) {
     CandidatePath c = candidate(length_m, blind);
     c.blind_length_m = blind_m;
-    c.near_blind_m = blind_m;  // selection.blind_horizon_m 0: the whole path's
     return c;
   };
   std::vector<CandidatePath> masked{blind_for(14.0, 14.0), blind_for(17.0, 0.6), blind_for(16.0, 0.8),
