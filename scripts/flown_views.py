@@ -11,9 +11,9 @@ a window was rated blind anyway (the rating's false alarms).
 
 A window is [effective_s, the next rated plan's effective_s or effective_s + replan_period_s]; its
 worst view counts only if it lies inside the window (a later plan replaced the views after it).
-A plan made on a map with no landmarks (from no map, the plan before take-off) rates every view
-blind: a loss in its window says 'nothing mapped yet', and its window is not counted among those
-the VO came through.
+A plan made on a map with no landmarks, mapped or of trial.unseen_prior (from no map, the plan before
+take-off), rates every view blind: a loss in its window says 'nothing mapped yet', and its window is
+not counted among those the VO came through.
 
 usage: flown_views.py RESULTS... [--out CSV] [--threshold P]
 RESULTS: sweep folders (their trials/*) or trial folders (metrics.json, online.json, vo.csv).
@@ -112,8 +112,12 @@ def foreseen(p, lost, threshold):
     return p['flown_min_p'] < threshold and p['flown_min_at_s'] <= lost + 0.5
 
 
+def empty_map(p):
+    return p['landmarks'] + p['prior_landmarks'] == 0
+
+
 def attribution(p, lost, threshold):
-    if p['landmarks'] == 0:
+    if empty_map(p):
         return 'rated blind: nothing mapped yet'
     if p['flown_min_p'] >= threshold:
         return 'rated trackable'
@@ -134,8 +138,9 @@ def analyse(folder, threshold):
         raise InputError(f"{folder}/online.json: key 'plans' missing")
     if plans and 'flown_min_p' not in plans[0]:
         raise InputError(f"{folder}/online.json: key 'flown_min_p' missing (flown before the flown views were rated)")
-    if plans and 'landmarks' not in plans[0]:
-        raise InputError(f"{folder}/online.json: key 'landmarks' missing")
+    for key in ('landmarks', 'prior_landmarks'):
+        if plans and key not in plans[0]:
+            raise InputError(f"{folder}/online.json: key '{key}' missing")
     period = replan_period(folder)
     lost = m.get('vo_lost_at_s')
     times, inliers = vo_inliers(folder)
@@ -150,7 +155,7 @@ def analyse(folder, threshold):
             continue
         if p['flown_min_at_s'] > end + 1e-9:
             continue  # replaced before that view was flown
-        if p['landmarks'] == 0:
+        if empty_map(p):
             continue  # nothing mapped: every view rates blind
         passed.append((p['flown_min_p'], at(times, inliers, p['flown_min_at_s'])))
     row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='')

@@ -18,10 +18,10 @@ SCRIPTS_DIR = os.environ.get("TGNAV_SCRIPTS_DIR") or os.path.join(os.path.dirnam
 SCRIPT = os.path.join(os.path.abspath(SCRIPTS_DIR), "flown_views.py")
 
 
-def plan(t, flown_p, at_s, own_p=-1.0, flown=True, landmarks=100):
+def plan(t, flown_p, at_s, own_p=-1.0, flown=True, landmarks=100, prior_landmarks=0):
     return {"t_s": t, "effective_s": t + 0.5, "adopted": False, "views_renewed": flown,
             "flown_min_p": flown_p if flown else -1.0, "flown_min_at_s": at_s if flown else -1.0,
-            "own_min_p": own_p, "landmarks": landmarks}
+            "own_min_p": own_p, "landmarks": landmarks, "prior_landmarks": prior_landmarks}
 
 
 def dump(obj, path):
@@ -99,6 +99,8 @@ class FlownViews(unittest.TestCase):
         # window and was lost in the next plan's. g: lost in the empty map's own window.
         write_trial(self.root, "f", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0), plan(2.0, 0.9, 3.0)], lost=4.0)
         write_trial(self.root, "g", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0)], lost=2.0)
+        # k: none mapped, but trial.unseen_prior's landmarks rated it: a rating like any other.
+        write_trial(self.root, "k", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0, prior_landmarks=50)], lost=2.0)
         out = os.path.join(self.root, "fv.csv")
         r = run(self.root, "--out", out)
         self.assertEqual(r.returncode, 0, r.stderr)
@@ -107,6 +109,7 @@ class FlownViews(unittest.TestCase):
         self.assertEqual(int(rows["f"]["windows_passed"]), 0)
         self.assertEqual(rows["g"]["attribution"], "rated blind: nothing mapped yet")
         self.assertEqual(int(rows["g"]["windows_passed_rated_blind"]), 0)
+        self.assertEqual(rows["k"]["attribution"], "rated blind: the plan's own views")
         bad = write_trial(self.root, "h", [{k: v for k, v in plan(0.0, 0.5, 1.0).items() if k != "landmarks"}])
         r = run(bad)
         self.assertEqual(r.returncode, 2)
