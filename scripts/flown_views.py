@@ -136,11 +136,10 @@ def analyse(folder, threshold):
     plans = online.get('plans')
     if not isinstance(plans, list):
         raise InputError(f"{folder}/online.json: key 'plans' missing")
-    if plans and 'flown_min_p' not in plans[0]:
-        raise InputError(f"{folder}/online.json: key 'flown_min_p' missing (flown before the flown views were rated)")
-    for key in ('landmarks', 'prior_landmarks'):
+    for key, why in (('flown_min_p', ' (flown before the flown views were rated)'), ('landmarks', ''),
+                     ('prior_landmarks', '')):
         if plans and key not in plans[0]:
-            raise InputError(f"{folder}/online.json: key '{key}' missing")
+            raise InputError(f"{folder}/online.json: key '{key}' missing{why}")
     period = replan_period(folder)
     lost = m.get('vo_lost_at_s')
     times, inliers = vo_inliers(folder)
@@ -159,12 +158,12 @@ def analyse(folder, threshold):
             continue  # nothing mapped: every view rates blind
         passed.append((p['flown_min_p'], at(times, inliers, p['flown_min_at_s'])))
     row.update(loss_plan_s='', flown_min_p='', flown_min_at_s='', own_min_p='', attribution='')
-    if lost is not None:
-        row['attribution'] = 'no rated plan'
-    if lost is not None and in_force is not None:
+    if in_force is not None:
         p = in_force
         row.update(loss_plan_s=p['t_s'], flown_min_p=p['flown_min_p'], flown_min_at_s=p['flown_min_at_s'],
                    own_min_p=p['own_min_p'], attribution=attribution(p, lost, threshold))
+    elif lost is not None:
+        row['attribution'] = 'no rated plan'
     row['windows_passed'] = len(passed)
     row['windows_passed_rated_blind'] = sum(1 for q, _ in passed if q < threshold)
     return row, passed

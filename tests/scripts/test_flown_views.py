@@ -57,9 +57,13 @@ class FlownViews(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
-    def rows(self, out):
+    def analyse_all(self):
+        """Runs the script on every trial written, with --out; its result and the CSV's rows by trial."""
+        out = os.path.join(self.root, "fv.csv")
+        r = run(self.root, "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
         with open(out) as f:
-            return {r["trial"]: r for r in csv.DictReader(f)}
+            return r, {row["trial"]: row for row in csv.DictReader(f)}
 
     def test_attributes_each_loss_to_the_plan_in_force_and_counts_false_alarms(self):
         # a: lost at 5.0 in the window of the plan at 4.0 (effective 4.5), which rated a view blind
@@ -75,10 +79,7 @@ class FlownViews(unittest.TestCase):
         # d: no loss; two windows rated blind, one of whose worst view a later plan replaced first.
         write_trial(self.root, "d", [plan(0.0, 0.2, 1.0, own_p=0.9), plan(2.0, 0.1, 6.0, own_p=0.9), plan(4.0, 0.9, 5.0),
                                      plan(6.0, 0.5, 6.6, flown=False)], inliers=444)
-        out = os.path.join(self.root, "fv.csv")
-        r = run(self.root, "--out", out)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        rows = self.rows(out)
+        r, rows = self.analyse_all()
         self.assertEqual(rows["a"]["attribution"], "rated blind: turned by the look-ahead or splice")
         self.assertEqual(float(rows["a"]["loss_plan_s"]), 4.0)
         self.assertEqual(rows["b"]["attribution"], "rated blind: the plan's own views")
@@ -101,10 +102,7 @@ class FlownViews(unittest.TestCase):
         write_trial(self.root, "g", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0)], lost=2.0)
         # k: none mapped, but trial.unseen_prior's landmarks rated it: a rating like any other.
         write_trial(self.root, "k", [plan(0.0, 0.07, 1.0, own_p=0.07, landmarks=0, prior_landmarks=50)], lost=2.0)
-        out = os.path.join(self.root, "fv.csv")
-        r = run(self.root, "--out", out)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        rows = self.rows(out)
+        r, rows = self.analyse_all()
         self.assertEqual(rows["f"]["attribution"], "rated trackable")
         self.assertEqual(int(rows["f"]["windows_passed"]), 0)
         self.assertEqual(rows["g"]["attribution"], "rated blind: nothing mapped yet")
