@@ -182,6 +182,9 @@ struct OnlineConfig {
   // mapped online: from the premise scenes' starts, a median of 23.5 landmarks mapped in 2 s against
   // 591 at 10 m. Measured at 10 m and left at 6: storage 3/10 against 9/10 (docs/results/first_look).
   double map_range_m = 6.0;
+  // The online map's depth rays clear free space only short of the surface they hit
+  // (MapBuildConfig::free_short_of_surface).
+  bool map_short_of_surface = false;
   // Simulated time from take-off; beyond it the flight stops. 300 s: gallery's online flight on
   // the true pose alone took 115 s for its 38 m (docs/results/online10/truth), so 120 s stopped
   // flights that were still tracking and making way.
@@ -219,6 +222,7 @@ struct OnlineConfig {
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("map_range_m", map_range_m);
+    a("map_short_of_surface", map_short_of_surface);
     a("max_flight_s", max_flight_s);
   }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <unordered_map>
@@ -167,6 +168,10 @@ void IncrementalMapper::setPrior(const octomap::OcTree& occupancy, std::vector<p
 }
 
 void IncrementalMapper::insertDepth(const RgbdFrame& frame, int stride_px) {
+  if (config_.free_short_of_surface) {
+    insertDepthShortOfSurface(frame, stride_px);
+    return;
+  }
   const Eigen::Vector3d origin = frame.X_WC.translation();
   octomap::Pointcloud cloud;
   for (int v = 0; v < k_.height_px; v += stride_px) {
@@ -180,6 +185,77 @@ void IncrementalMapper::insertDepth(const RgbdFrame& frame, int stride_px) {
   }
   tree_->insertPointCloud(cloud, octomap::point3d(origin.x(), origin.y(), origin.z()), config_.max_range_m,
                           /*lazy_eval=*/false, /*discretize=*/true);
+}
+
+void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int stride_px) {
+  const double res = config_.resolution_m;
+  const Eigen::Vector3d origin = frame.X_WC.translation();
+  const octomap::point3d o(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
+                           static_cast<float>(origin.z()));
+  const cv::Mat& depth = frame.depth_m;
+  const auto point = [&](int u, int v) {
+    const double z = depth.at<float>(v, u);
+    return Eigen::Vector3d((u - k_.cx) / k_.fx * z, (v - k_.cy) / k_.fy * z, z);
+  };
+  // The step to the pixel `stride_px` on along one image axis, on the side whose depth changes
+  // least (off a depth edge); zero where neither has depth. The stride, not the next pixel: a
+  // longer base averages out depth noise (camera.depth_noise_sigma_per_m2) in the normal.
+  const auto step = [&](int u, int v, int du, int dv) -> Eigen::Vector3d {
+    const double z = depth.at<float>(v, u);
+    Eigen::Vector3d best = Eigen::Vector3d::Zero();
+    double best_dz = std::numeric_limits<double>::infinity();
+    for (const int sign : {1, -1}) {
+      const int u2 = u + sign * du;
+      const int v2 = v + sign * dv;
+      if (u2 < 0 || v2 < 0 || u2 >= depth.cols || v2 >= depth.rows || depth.at<float>(v2, u2) <= 0.0F) continue;
+      const double dz = std::abs(depth.at<float>(v2, u2) - z);
+      if (dz < best_dz) {
+        best_dz = dz;
+        best = sign * (point(u2, v2) - point(u, v));
+      }
+    }
+    return best;
+  };
+  octomap::KeySet free_cells;
+  octomap::KeySet occupied_cells;
+  octomap::KeyRay ray;
+  const auto clearTo = [&](const Eigen::Vector3d& end_W) {
+    const octomap::point3d e(static_cast<float>(end_W.x()), static_cast<float>(end_W.y()),
+                             static_cast<float>(end_W.z()));
+    if (tree_->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
+    octomap::OcTreeKey key;
+    if (tree_->coordToKeyChecked(e, key)) free_cells.insert(key);
+  };
+  for (int v = 0; v < k_.height_px; v += stride_px) {
+    for (int u = 0; u < k_.width_px; u += stride_px) {
+      if (depth.at<float>(v, u) <= 0.0F) continue;
+      const Eigen::Vector3d p_C = point(u, v);
+      const double range = p_C.norm();
+      const Eigen::Vector3d dir_C = p_C / range;
+      if (range > config_.max_range_m) {  // as OctoMap: free up to the range, no surface
+        clearTo(frame.X_WC * (config_.max_range_m * dir_C));
+        continue;
+      }
+      octomap::OcTreeKey hit;
+      const Eigen::Vector3d p_W = frame.X_WC * p_C;
+      if (!tree_->coordToKeyChecked(
+              octomap::point3d(static_cast<float>(p_W.x()), static_cast<float>(p_W.y()), static_cast<float>(p_W.z())),
+              hit)) {
+        continue;
+      }
+      occupied_cells.insert(hit);
+      const Eigen::Vector3d normal = step(u, v, stride_px, 0).cross(step(u, v, 0, stride_px));
+      const double n = normal.norm();
+      // Where the surface's normal is unknown (an isolated pixel), as at a grazing angle.
+      const double cos_incidence = n > 0.0 ? std::abs(normal.dot(dir_C)) / n : 0.0;
+      const double short_m = cos_incidence * range > res ? res / cos_incidence : range;
+      if (short_m < range) clearTo(frame.X_WC * ((range - short_m) * dir_C));
+    }
+  }
+  for (const octomap::OcTreeKey& key : free_cells) {
+    if (occupied_cells.count(key) == 0) tree_->updateNode(key, false);
+  }
+  for (const octomap::OcTreeKey& key : occupied_cells) tree_->updateNode(key, true);
 }
 
 void IncrementalMapper::observeFeatures(const RgbdFrame& frame) {

@@ -58,7 +58,8 @@ class IncrementalMapper {
   // detectability counted elsewhere); the frames' landmarks are added to them.
   void setPrior(const octomap::OcTree& occupancy, std::vector<planner::Landmark> landmarks);
 
-  // Ray-inserts every `stride_px`-th depth pixel of `frame` at frame.X_WC.
+  // Ray-inserts every `stride_px`-th depth pixel of `frame` at frame.X_WC (short of the surface
+  // with config.free_short_of_surface).
   void insertDepth(const RgbdFrame& frame, int stride_px);
   // Detects its ORB keypoints, merges those with a stable depth into the landmarks, and keeps a
   // sampled depth of the view for counting opportunities.
@@ -95,6 +96,7 @@ class IncrementalMapper {
     int opportunities = 0;
   };
   Built build(std::unique_ptr<octomap::OcTree> tree);
+  void insertDepthShortOfSurface(const RgbdFrame& frame, int stride_px);
 
   MapBuildConfig config_;
   Intrinsics k_;

@@ -49,6 +49,37 @@ MapError mapError(const octomap::OcTree& tree, const SceneConfig& scene, const S
   return e;
 }
 
+MapHoles mapHoles(const octomap::OcTree& tree, const Scenario& scenario, const SceneGeometry& truth) {
+  const double res = tree.getResolution();
+  const SceneConfig& scene = scenario.scene;
+  const ClearanceBand band = clearanceBand(scenario);
+  // -1 unknown, 0 free, 1 occupied.
+  const auto state = [&](const Eigen::Vector3d& p) {
+    const octomap::OcTreeNode* n = tree.search(p.x(), p.y(), p.z());
+    return n == nullptr ? -1 : tree.isNodeOccupied(n) ? 1 : 0;
+  };
+  MapHoles out;
+  for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
+    for (double y = scene.bounds_min_m.y() + 0.5 * res; y < scene.bounds_max_m.y(); y += res) {
+      for (double x = scene.bounds_min_m.x() + 0.5 * res; x < scene.bounds_max_m.x(); x += res) {
+        const Eigen::Vector3d c(x, y, z);
+        if (truth.signedDistance(c) <= 0.0) continue;
+        for (const Eigen::Vector3d& step : {Eigen::Vector3d(res, 0, 0), Eigen::Vector3d(-res, 0, 0),
+                                            Eigen::Vector3d(0, res, 0), Eigen::Vector3d(0, -res, 0)}) {
+          const Eigen::Vector3d n = c + step;
+          if (truth.signedDistance(n) > 0.0) continue;
+          const int sc = state(c);
+          const int sn = state(n);
+          if (sc < 0 && sn < 0) continue;
+          ++out.crossings;
+          out.holes += sn == 0 && sc != 1 ? 1 : 0;
+        }
+      }
+    }
+  }
+  return out;
+}
+
 namespace {
 
 // The plan in effect at time t: the last that took effect by then (the first before any).

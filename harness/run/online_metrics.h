@@ -25,6 +25,18 @@ struct MapError {
 };
 MapError mapError(const octomap::OcTree& tree, const SceneConfig& scene, const SceneGeometry& truth);
 
+// The other side of the map's error: true surfaces the map lets a planner through. At the voxel
+// centres of the flight band (clearanceBand) inside the scene's bounds, a crossing is a step to a
+// horizontal neighbour from a centre outside the true geometry to one inside it: a surface lies
+// between them, or in one of the two. It is observed when the map knows either voxel, and a hole
+// when the inside voxel is known free and neither is occupied (the map says free inside a solid).
+struct MapHoles {
+  int crossings = 0;  // observed
+  int holes = 0;
+  double share() const { return crossings > 0 ? static_cast<double>(holes) / crossings : 0.0; }
+};
+MapHoles mapHoles(const octomap::OcTree& tree, const Scenario& scenario, const SceneGeometry& truth);
+
 // Of the flown points (time, estimated position), the share whose nearest point on the plan in
 // effect then (the last adopted one to have taken effect; the first before any) was unknown when
 // that plan was made.

@@ -28,6 +28,7 @@ MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const OnlineCo
   MapBuildConfig config;
   config.resolution_m = survey.resolution();
   config.max_range_m = online.map_range_m;
+  config.free_short_of_surface = online.map_short_of_surface;
   return config;
 }
 
@@ -413,6 +414,9 @@ OnlineResult OnlinePlanning::finish(const SceneGeometry& truth,
   out.occupied_voxels = error.occupied_voxels;
   out.map_error_mean_m = error.mean_m;
   out.map_error_far_share = error.far_share;
+  const MapHoles holes = mapHoles(tree, scenario_, truth);
+  out.map_surface_crossings = holes.crossings;
+  out.map_hole_share = holes.share();
   out.unknown_share = unknownShare(out.plans, flown);
   return out;
 }

@@ -109,6 +109,8 @@ struct OnlineResult {
   int occupied_voxels = 0;                    // in the final map, inside the bounds widened by 0.5 m
   double map_error_mean_m = 0.0;              // their centres' mean distance to the true geometry
   double map_error_far_share = 0.0;           // ... share farther than two voxels from it
+  int map_surface_crossings = 0;              // observed in the flight band (online_metrics.h, mapHoles)
+  double map_hole_share = 0.0;                // ... of them, where the map is free inside the true geometry
   double unknown_share = 0.0;                 // of the flown trajectory: in space unknown when planned
   std::optional<std::string> planner_stderr;  // an external planner's: the last lines it wrote to stderr
   std::vector<GuardEvent> guards;             // trial.guard_tracking: when the guard tripped

@@ -130,6 +130,8 @@ nlohmann::ordered_json onlineJson(const Scenario& scenario, const TrialResult& r
   j["map_occupied_voxels"] = o.occupied_voxels;
   j["map_error_mean_m"] = o.map_error_mean_m;
   j["map_error_far_share"] = o.map_error_far_share;
+  j["map_surface_crossings"] = o.map_surface_crossings;
+  j["map_hole_share"] = o.map_hole_share;
   j["unknown_share"] = o.unknown_share;
   return j;
 }

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <iostream>
 
+#include "harness/config/scenario.h"
 #include "harness/run/map_builder.h"
+#include "harness/run/online_metrics.h"
 #include "harness/sim/mujoco_sim.h"
 #include "harness/sim/scene_geometry.h"
 #include "planner/occupancy_grid.h"
@@ -113,6 +115,37 @@ TEST_F(SmokeMapTest, OccupancyAgreesWithTheGeometryAtFlightHeight) {
   EXPECT_GE(occupied_ratio, 0.95);
   EXPECT_LE(false_ratio, 0.02);
   EXPECT_GE(static_cast<double>(free_known) / free_total, 0.9);
+}
+
+// The online map's holes (online_metrics.h, mapHoles) on the survey's map: few, and every
+// surface voxel punched free at the flight height counted.
+TEST_F(SmokeMapTest, HolesAreTheTrueSurfacesTheMapSaysAreFree) {
+  const Scenario scenario = loadScenario(test::sourceDir() / "configs/scenarios/smoke.yaml");
+  const MapHoles survey = mapHoles(map_->occupancy(), scenario, *geometry_);
+  std::cout << "[ figure   ] smoke survey map: " << survey.holes << " holes of " << survey.crossings
+            << " observed surface crossings in the flight band (" << 100 * survey.share() << " %)\n";
+  EXPECT_GT(survey.crossings, 1000);
+  EXPECT_LT(survey.share(), 0.02);
+  // Punch the flight layer's occupied voxels inside the geometry whose outer neighbour (-x) is
+  // free: each is then a hole.
+  octomap::OcTree tree(map_->occupancy());
+  const double res = tree.getResolution();
+  int punched = 0;
+  for (const Eigen::Vector3d& c : flightLayer()) {
+    const Eigen::Vector3d out = c - Eigen::Vector3d(res, 0.0, 0.0);
+    if (geometry_->signedDistance(c) > 0.0 || geometry_->signedDistance(out) <= 0.0) continue;
+    const octomap::OcTreeNode* in_node = tree.search(c.x(), c.y(), c.z());
+    const octomap::OcTreeNode* out_node = tree.search(out.x(), out.y(), out.z());
+    if (in_node == nullptr || !tree.isNodeOccupied(in_node) || out_node == nullptr || tree.isNodeOccupied(out_node)) {
+      continue;
+    }
+    while (tree.isNodeOccupied(tree.search(c.x(), c.y(), c.z()))) tree.updateNode(c.x(), c.y(), c.z(), false);
+    ++punched;
+  }
+  const MapHoles after = mapHoles(tree, scenario, *geometry_);
+  ASSERT_GT(punched, 10);
+  EXPECT_EQ(after.crossings, survey.crossings);
+  EXPECT_GE(after.holes, survey.holes + punched);
 }
 
 TEST_F(SmokeMapTest, LandmarksLieOnSurfaces) {
