@@ -1,6 +1,9 @@
 #include "harness/run/online_metrics.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "harness/run/incremental_map.h"
 #include "harness/run/plan_run.h"
@@ -53,26 +56,50 @@ MapHoles mapHoles(const octomap::OcTree& tree, const Scenario& scenario, const S
   const double res = tree.getResolution();
   const SceneConfig& scene = scenario.scene;
   const ClearanceBand band = clearanceBand(scenario);
-  // -1 unknown, 0 free, 1 occupied.
-  const auto state = [&](const Eigen::Vector3d& p) {
-    const octomap::OcTreeNode* n = tree.search(p.x(), p.y(), p.z());
-    return n == nullptr ? -1 : tree.isNodeOccupied(n) ? 1 : 0;
+  // The centres in the bounds (as mapCoverage steps them), and one more on each side: the scene's
+  // outer walls lie just outside its free-space bounds.
+  const auto centres = [res](double lo, double hi) {
+    std::vector<double> c{lo + 0.5 * res - res};
+    for (double v = lo + 0.5 * res; v < hi; v += res) c.push_back(v);
+    c.push_back(c.back() + res);
+    return c;
   };
+  const std::vector<double> xs = centres(scene.bounds_min_m.x(), scene.bounds_max_m.x());
+  const std::vector<double> ys = centres(scene.bounds_min_m.y(), scene.bounds_max_m.y());
+  const int nx = static_cast<int>(xs.size());
+  const int ny = static_cast<int>(ys.size());
   MapHoles out;
+  // Per centre of a layer, computed when first asked: the map's state, and whether it lies inside
+  // the true geometry. The geometry is asked only next to what the map knows: that is most of the
+  // cost.
+  enum : std::uint8_t { kNotYet, kUnknown, kFree, kOccupied, kOutside, kInside };
+  std::vector<std::uint8_t> state(static_cast<std::size_t>(nx) * ny);
+  std::vector<std::uint8_t> inside(state.size());
   for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
-    for (double y = scene.bounds_min_m.y() + 0.5 * res; y < scene.bounds_max_m.y(); y += res) {
-      for (double x = scene.bounds_min_m.x() + 0.5 * res; x < scene.bounds_max_m.x(); x += res) {
-        const Eigen::Vector3d c(x, y, z);
-        if (truth.signedDistance(c) <= 0.0) continue;
-        for (const Eigen::Vector3d& step : {Eigen::Vector3d(res, 0, 0), Eigen::Vector3d(-res, 0, 0),
-                                            Eigen::Vector3d(0, res, 0), Eigen::Vector3d(0, -res, 0)}) {
-          const Eigen::Vector3d n = c + step;
-          if (truth.signedDistance(n) > 0.0) continue;
-          const int sc = state(c);
-          const int sn = state(n);
-          if (sc < 0 && sn < 0) continue;
+    std::fill(state.begin(), state.end(), kNotYet);
+    std::fill(inside.begin(), inside.end(), kNotYet);
+    const auto at = [nx](int i, int j) { return static_cast<std::size_t>(j) * nx + i; };
+    const auto stateOf = [&](int i, int j) {
+      std::uint8_t& s = state[at(i, j)];
+      if (s == kNotYet) {
+        const octomap::OcTreeNode* n = tree.search(xs[i], ys[j], z);
+        s = n == nullptr ? kUnknown : tree.isNodeOccupied(n) ? kOccupied : kFree;
+      }
+      return s;
+    };
+    const auto insideOf = [&](int i, int j) {
+      std::uint8_t& s = inside[at(i, j)];
+      if (s == kNotYet) s = truth.signedDistance(Eigen::Vector3d(xs[i], ys[j], z)) <= 0.0 ? kInside : kOutside;
+      return s == kInside;
+    };
+    for (int j = 1; j + 1 < ny; ++j) {
+      for (int i = 1; i + 1 < nx; ++i) {
+        for (const auto& [di, dj] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+          const std::uint8_t sc = stateOf(i, j);
+          const std::uint8_t sn = stateOf(i + di, j + dj);
+          if ((sc == kUnknown && sn == kUnknown) || insideOf(i, j) || !insideOf(i + di, j + dj)) continue;
           ++out.crossings;
-          out.holes += sn == 0 && sc != 1 ? 1 : 0;
+          out.holes += sn == kFree && sc != kOccupied ? 1 : 0;
         }
       }
     }
