@@ -14,9 +14,6 @@
 namespace tgnav::planner {
 
 namespace {
-octomap::point3d toOcto(const Eigen::Vector3d& p) {
-  return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-}
 Eigen::Vector3d toEigen(const octomap::point3d& p) { return Eigen::Vector3d(p.x(), p.y(), p.z()); }
 }  // namespace
 

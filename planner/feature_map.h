@@ -15,6 +15,11 @@
 
 namespace tgnav::planner {
 
+// An Eigen point as OctoMap's (single precision).
+inline octomap::point3d toOcto(const Eigen::Vector3d& p) {
+  return octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+}
+
 struct Landmark {
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();  // mean of its observations
   int observations = 1;

@@ -189,9 +189,7 @@ void IncrementalMapper::insertDepth(const RgbdFrame& frame, int stride_px) {
 
 void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int stride_px) {
   const double res = config_.resolution_m;
-  const Eigen::Vector3d origin = frame.X_WC.translation();
-  const octomap::point3d o(static_cast<float>(origin.x()), static_cast<float>(origin.y()),
-                           static_cast<float>(origin.z()));
+  const octomap::point3d o = planner::toOcto(frame.X_WC.translation());
   const cv::Mat& depth = frame.depth_m;
   const auto point = [&](int u, int v) {
     const double z = depth.at<float>(v, u);
@@ -200,18 +198,17 @@ void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int st
   // The step to the pixel `stride_px` on along one image axis, on the side whose depth changes
   // least (off a depth edge); zero where neither has depth. The stride, not the next pixel: a
   // longer base averages out depth noise (camera.depth_noise_sigma_per_m2) in the normal.
-  const auto step = [&](int u, int v, int du, int dv) -> Eigen::Vector3d {
-    const double z = depth.at<float>(v, u);
+  const auto step = [&](int u, int v, const Eigen::Vector3d& p_C, int du, int dv) -> Eigen::Vector3d {
     Eigen::Vector3d best = Eigen::Vector3d::Zero();
     double best_dz = std::numeric_limits<double>::infinity();
     for (const int sign : {1, -1}) {
       const int u2 = u + sign * du;
       const int v2 = v + sign * dv;
       if (u2 < 0 || v2 < 0 || u2 >= depth.cols || v2 >= depth.rows || depth.at<float>(v2, u2) <= 0.0F) continue;
-      const double dz = std::abs(depth.at<float>(v2, u2) - z);
+      const double dz = std::abs(depth.at<float>(v2, u2) - p_C.z());
       if (dz < best_dz) {
         best_dz = dz;
-        best = sign * (point(u2, v2) - point(u, v));
+        best = sign * (point(u2, v2) - p_C);
       }
     }
     return best;
@@ -220,8 +217,7 @@ void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int st
   octomap::KeySet occupied_cells;
   octomap::KeyRay ray;
   const auto clearTo = [&](const Eigen::Vector3d& end_W) {
-    const octomap::point3d e(static_cast<float>(end_W.x()), static_cast<float>(end_W.y()),
-                             static_cast<float>(end_W.z()));
+    const octomap::point3d e = planner::toOcto(end_W);
     if (tree_->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
     octomap::OcTreeKey key;
     if (tree_->coordToKeyChecked(e, key)) free_cells.insert(key);
@@ -237,14 +233,9 @@ void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int st
         continue;
       }
       octomap::OcTreeKey hit;
-      const Eigen::Vector3d p_W = frame.X_WC * p_C;
-      if (!tree_->coordToKeyChecked(
-              octomap::point3d(static_cast<float>(p_W.x()), static_cast<float>(p_W.y()), static_cast<float>(p_W.z())),
-              hit)) {
-        continue;
-      }
+      if (!tree_->coordToKeyChecked(planner::toOcto(frame.X_WC * p_C), hit)) continue;
       occupied_cells.insert(hit);
-      const Eigen::Vector3d normal = step(u, v, stride_px, 0).cross(step(u, v, 0, stride_px));
+      const Eigen::Vector3d normal = step(u, v, p_C, stride_px, 0).cross(step(u, v, p_C, 0, stride_px));
       const double n = normal.norm();
       // Where the surface's normal is unknown (an isolated pixel), as at a grazing angle.
       const double cos_incidence = n > 0.0 ? std::abs(normal.dot(dir_C)) / n : 0.0;
@@ -351,9 +342,7 @@ octomap::OcTree cropOccupancy(const octomap::OcTree& tree, const Eigen::Vector3d
   for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
     forEachVoxel(it, res, [&](const Eigen::Vector3d& p) {
       if ((p - centre).head<2>().norm() > radius_m) return;
-      out.setNodeValue(
-          octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())),
-          it->getLogOdds(), /*lazy_eval=*/true);
+      out.setNodeValue(planner::toOcto(p), it->getLogOdds(), /*lazy_eval=*/true);
     });
   }
   out.updateInnerOccupancy();

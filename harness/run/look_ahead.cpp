@@ -163,8 +163,7 @@ bool observedAround(const Eigen::Vector3d& p, const planner::FeatureMap& map,
   const double res = map.resolution();
   const int n = static_cast<int>(std::ceil(clear_m / res));
   const octomap::OcTree& tree = map.occupancy();
-  const octomap::point3d c = tree.keyToCoord(tree.coordToKey(
-      octomap::point3d(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()))));
+  const octomap::point3d c = tree.keyToCoord(tree.coordToKey(planner::toOcto(p)));
   const Eigen::Vector3d centre(c.x(), c.y(), c.z());
   for (int i = -n; i <= n; ++i) {
     for (int j = -n; j <= n; ++j) {

@@ -75,10 +75,10 @@ MapHoles mapHoles(const octomap::OcTree& tree, const Scenario& scenario, const S
   enum : std::uint8_t { kNotYet, kUnknown, kFree, kOccupied, kOutside, kInside };
   std::vector<std::uint8_t> state(static_cast<std::size_t>(nx) * ny);
   std::vector<std::uint8_t> inside(state.size());
+  const auto at = [nx](int i, int j) { return static_cast<std::size_t>(j) * nx + i; };
   for (double z = band.lo_m + 0.5 * res; z < band.hi_m; z += res) {
     std::fill(state.begin(), state.end(), kNotYet);
     std::fill(inside.begin(), inside.end(), kNotYet);
-    const auto at = [nx](int i, int j) { return static_cast<std::size_t>(j) * nx + i; };
     const auto stateOf = [&](int i, int j) {
       std::uint8_t& s = state[at(i, j)];
       if (s == kNotYet) {
@@ -94,8 +94,8 @@ MapHoles mapHoles(const octomap::OcTree& tree, const Scenario& scenario, const S
     };
     for (int j = 1; j + 1 < ny; ++j) {
       for (int i = 1; i + 1 < nx; ++i) {
+        const std::uint8_t sc = stateOf(i, j);
         for (const auto& [di, dj] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
-          const std::uint8_t sc = stateOf(i, j);
           const std::uint8_t sn = stateOf(i + di, j + dj);
           if ((sc == kUnknown && sn == kUnknown) || insideOf(i, j) || !insideOf(i + di, j + dj)) continue;
           ++out.crossings;
