@@ -22,14 +22,19 @@ double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 // The voxel columns at the flight height, as the search sees them.
 class Columns {
  public:
-  Columns(const planner::VoxelMap& voxels, const LookConfig& config, const std::vector<Eigen::Vector3d>& visited)
+  Columns(const planner::VoxelMap& voxels, const LookConfig& config, const LookMemory& memory)
       : res_(voxels.resolution()),
         origin_(voxels.origin().head<2>()),
         nx_(voxels.size().x()),
         ny_(voxels.size().y()),
         occupied_(static_cast<std::size_t>(nx_) * ny_, 0),
         known_(occupied_.size(), 0),
-        seen_(occupied_.size(), 0) {
+        seen_(occupied_.size(), 0),
+        given_up_(occupied_.size(), 0) {
+    for (const Eigen::Vector2d& p : memory.given_up) {
+      const auto [i, j] = cellOf(p);
+      if (inside(i, j)) given_up_[index(i, j)] = 1;
+    }
     const double h = config.flight_height_m;
     const int layers = static_cast<int>(std::ceil(config.robot_radius_m / res_));
     for (int j = 0; j < ny_; ++j) {
@@ -44,7 +49,7 @@ class Columns {
         const bool observed = voxels.observed(Eigen::Vector3d(c.x(), c.y(), h));
         double nearest = std::numeric_limits<double>::infinity();  // to a visited place
         if (!observed) {
-          for (const Eigen::Vector3d& v : visited) nearest = std::min(nearest, (v.head<2>() - c).norm());
+          for (const Eigen::Vector3d& v : memory.visited) nearest = std::min(nearest, (v.head<2>() - c).norm());
         }
         known_[at] = observed || nearest <= config.visited_clear_m ? 1 : 0;
         seen_[at] = observed || nearest <= config.robot_radius_m ? 1 : 0;
@@ -63,6 +68,8 @@ class Columns {
   }
   bool occupied(std::size_t at) const { return occupied_[at] != 0; }
   bool known(std::size_t at) const { return known_[at] != 0; }
+  // Unknown, and not given up on: what a view counts as observing.
+  bool toObserve(std::size_t at) const { return known_[at] == 0 && given_up_[at] == 0; }
   // Whether the segment from p to q crosses only observed columns (occupied or free; of visited
   // places, only the disc of the robot radius) before its last `end_m`: what lies across unknown
   // space may be hidden by what is not mapped yet.
@@ -100,25 +107,29 @@ class Columns {
   std::vector<std::uint8_t> occupied_;
   std::vector<std::uint8_t> known_;  // observed, or within visited_clear_m of a visited place
   std::vector<std::uint8_t> seen_;   // observed, or within the robot radius of one
+  std::vector<std::uint8_t> given_up_;
 };
 
 // What the views from one cell observe: per ray (kRayStepRad apart from angle 0), the unknown
 // columns it first reaches, of the way on and of any.
 struct CellSight {
   std::vector<int> way;
+  std::vector<int> near;  // ... within LookConfig::near_m of the way on (way included)
   std::vector<int> any;
 };
+
+// Which unknown columns a look counts: of the way on, near it, or any.
+enum class Tier { kWay, kNear, kAny };
 
 // The search of planLook() over (cell, yaw) states: state = cell * yaws + yaw index.
 class LookSearch {
  public:
-  LookSearch(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
-             const std::vector<Eigen::Vector3d>& visited, const std::vector<GuardEvent>& tripped,
+  LookSearch(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start, const LookMemory& memory,
              const LookConfig& config)
       : config_(config),
-        columns_(voxels, config, visited),
+        columns_(voxels, config, memory),
         rater_(rater),
-        tripped_(tripped),
+        tripped_(memory.tripped),
         lo_(voxels.origin().head<2>()),
         start_(start) {
     const Eigen::Vector2d extent = voxels.size().head<2>().cast<double>() * voxels.resolution();
@@ -184,39 +195,67 @@ class LookSearch {
 
   // The least-cost state it reached in the cell of p (-1: none).
   int reached(const Eigen::Vector2d& p) const {
-    const int i = static_cast<int>(std::floor((p.x() - lo_.x()) / config_.cell_m));
-    const int j = static_cast<int>(std::floor((p.y() - lo_.y()) / config_.cell_m));
-    if (i < 0 || j < 0 || i >= gx_ || j >= gy_) return -1;
+    const int cell = cellAt(p);
+    if (cell < 0) return -1;
     for (const int s : settled_) {
-      if (s / yaws_ == j * gx_ + i) return s;  // settled in order of cost
+      if (s / yaws_ == cell) return s;  // settled in order of cost
     }
     return -1;
   }
 
-  // The look pose among the states reached (planLook()), into out->seen and out->way; -1: none.
-  int chooseLook(const std::vector<Eigen::Vector3d>& way_on, const std::vector<planner::Pose4>& looked, LookPlan* out) {
-    markWay(way_on);
-    std::vector<int> way_seen(settled_.size(), 0);
-    std::vector<int> any_seen(settled_.size(), 0);
-    int best_way = 0;
-    int best_any = 0;
+  // The least-cost state in the cell farthest along `route` that the search reached, at least min_m
+  // along it from its first point, and not within config.repeat_m of a place flown to before (at
+  // any yaw: it advances, it does not look); -1: none.
+  int advance(const std::vector<Eigen::Vector3d>& route, double min_m,
+              const std::vector<planner::Pose4>& looked) const {
+    std::vector<int> first(static_cast<std::size_t>(gx_) * gy_, -1);  // per cell
+    for (const int s : settled_) {
+      int& f = first[at(s / yaws_)];
+      if (f >= 0 || s / yaws_ == start_cell_) continue;
+      const Eigen::Vector2d p = place(s / yaws_);
+      const bool flown = std::any_of(looked.begin(), looked.end(), [&](const planner::Pose4& l) {
+        return (l.p_WB.head<2>() - p).norm() <= config_.repeat_m;
+      });
+      if (!flown) f = s;
+    }
+    std::vector<std::pair<double, Eigen::Vector2d>> along;  // (distance along the route, point)
+    double d = 0.0;
+    for (std::size_t i = 0; i < route.size(); ++i) {
+      const Eigen::Vector2d p = route[i].head<2>();
+      if (i > 0) {
+        const Eigen::Vector2d q = route[i - 1].head<2>();
+        const int n = std::max(1, static_cast<int>(std::ceil((p - q).norm() / (0.5 * config_.cell_m))));
+        for (int k = 1; k <= n; ++k) along.emplace_back(d + (p - q).norm() * k / n, q + (p - q) * k / n);
+        d += (p - q).norm();
+      } else {
+        along.emplace_back(0.0, p);
+      }
+    }
+    for (auto it = along.rbegin(); it != along.rend() && it->first >= min_m; ++it) {
+      const int cell = cellAt(it->second);
+      if (cell >= 0 && first[at(cell)] >= 0) return first[at(cell)];
+    }
+    return -1;
+  }
+
+  // The look pose among the states reached (planLook()) whose view observes at least min_seen
+  // unknown columns of `tier` (out->seen); -1: none. markWay() first.
+  int chooseLook(Tier tier, int min_seen, const std::vector<planner::Pose4>& looked, LookPlan* out) {
+    std::vector<int> seen(settled_.size(), 0);
+    int best = 0;
     for (std::size_t n = 0; n < settled_.size(); ++n) {
       const int s = settled_[n];
       if (s == start_state_ || repeats(s, looked)) continue;  // the view it has now, or one flown to
       const CellSight& cs = sight(s / yaws_);
-      way_seen[n] = seenAlong(cs.way, yawOf(s % yaws_));
-      any_seen[n] = seenAlong(cs.any, yawOf(s % yaws_));
-      best_way = std::max(best_way, way_seen[n]);
-      best_any = std::max(best_any, any_seen[n]);
+      seen[n] = seenAlong(tier == Tier::kWay ? cs.way : tier == Tier::kNear ? cs.near : cs.any, yawOf(s % yaws_));
+      best = std::max(best, seen[n]);
     }
-    out->way = best_way > 0;
-    const std::vector<int>& seen = out->way ? way_seen : any_seen;
-    const int best = out->way ? best_way : best_any;
-    if (best <= 0) return -1;
-    // The nearest that sees at least half as much as the best; at equal cost, the one that sees more.
+    if (best <= 0 || best < min_seen) return -1;
+    // The nearest that sees at least half as much as the best (and min_seen); at equal cost, the one
+    // that sees more.
     int chosen = -1;
     for (std::size_t n = 0; n < settled_.size(); ++n) {
-      if (2 * seen[n] < best) continue;
+      if (2 * seen[n] < best || seen[n] < min_seen) continue;
       const double c = cost_[at(settled_[n])];
       if (chosen >= 0) {
         const double c0 = cost_[at(settled_[at(chosen)])];
@@ -226,6 +265,55 @@ class LookSearch {
     }
     out->seen = seen[at(chosen)];
     return settled_[at(chosen)];
+  }
+
+  // The centres of the columns of `tier` the view of `state` counts (sight()).
+  std::vector<Eigen::Vector2d> watched(int state, Tier tier) const {
+    const int cell = state / yaws_;
+    const Eigen::Vector2d from = place(cell);
+    const int rays = static_cast<int>(std::lround(2.0 * M_PI / kRayStepRad));
+    const int half = static_cast<int>(std::floor(config_.half_hfov_rad / kRayStepRad));
+    const int mid = static_cast<int>(std::lround(yawOf(state % yaws_) / kRayStepRad));
+    const int needed = tier == Tier::kWay ? 2 : tier == Tier::kNear ? 1 : 0;
+    const double dr = 0.5 * columns_.res();
+    std::vector<std::size_t> columns;
+    for (int r = mid - half; r <= mid + half; ++r) {
+      const double a = ((r % rays + rays) % rays) * kRayStepRad;
+      const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+      for (double d = dr; d <= config_.observe_range_m; d += dr) {
+        const auto [i, j] = columns_.cellOf(from + d * dir);
+        if (!columns_.inside(i, j)) break;
+        const std::size_t c = columns_.index(i, j);
+        if (columns_.occupied(c)) break;
+        if (columns_.toObserve(c) && on_way_[c] >= needed) columns.push_back(c);
+      }
+    }
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    std::vector<Eigen::Vector2d> centres;
+    for (const std::size_t c : columns) {
+      centres.push_back(columns_.centre(static_cast<int>(c % columns_.nx()), static_cast<int>(c / columns_.nx())));
+    }
+    return centres;
+  }
+
+  // The unknown columns within config.way_clear_m of the way on (2), or within config.near_m (1).
+  void markWay(const std::vector<Eigen::Vector3d>& way_on) {
+    on_way_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), 0);
+    const double near_m = std::max(config_.near_m, config_.way_clear_m);
+    const int reach = static_cast<int>(std::ceil(near_m / columns_.res()));
+    for (const Eigen::Vector3d& p : way_on) {
+      const auto [ci, cj] = columns_.cellOf(p.head<2>());
+      for (int j = cj - reach; j <= cj + reach; ++j) {
+        for (int i = ci - reach; i <= ci + reach; ++i) {
+          if (!columns_.inside(i, j)) continue;
+          const double d = (columns_.centre(i, j) - p.head<2>()).norm();
+          const std::size_t c = columns_.index(i, j);
+          if (d > near_m || columns_.known(c) || columns_.occupied(c)) continue;
+          on_way_[c] = std::max<std::uint8_t>(on_way_[c], d <= config_.way_clear_m ? 2 : 1);
+        }
+      }
+    }
   }
 
   // The poses from the start to `target`: the start as given, cell centres at the flight height,
@@ -255,6 +343,12 @@ class LookSearch {
 
  private:
   static std::size_t at(int i) { return static_cast<std::size_t>(i); }
+  // The cell of p; -1 outside the grid.
+  int cellAt(const Eigen::Vector2d& p) const {
+    const int i = static_cast<int>(std::floor((p.x() - lo_.x()) / config_.cell_m));
+    const int j = static_cast<int>(std::floor((p.y() - lo_.y()) / config_.cell_m));
+    return i < 0 || j < 0 || i >= gx_ || j >= gy_ ? -1 : j * gx_ + i;
+  }
   double yawOf(int k) const { return wrapAngle(k * step_); }
   Eigen::Vector2d centre(int cell) const {
     const int i = cell % gx_;
@@ -293,22 +387,6 @@ class LookSearch {
     return t;
   }
 
-  // The unknown columns within config.way_clear_m of the way on.
-  void markWay(const std::vector<Eigen::Vector3d>& way_on) {
-    on_way_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), 0);
-    const int reach = static_cast<int>(std::ceil(config_.way_clear_m / columns_.res()));
-    for (const Eigen::Vector3d& p : way_on) {
-      const auto [ci, cj] = columns_.cellOf(p.head<2>());
-      for (int j = cj - reach; j <= cj + reach; ++j) {
-        for (int i = ci - reach; i <= ci + reach; ++i) {
-          if (!columns_.inside(i, j) || (columns_.centre(i, j) - p.head<2>()).norm() > config_.way_clear_m) continue;
-          const std::size_t c = columns_.index(i, j);
-          if (!columns_.known(c) && !columns_.occupied(c)) on_way_[c] = 1;
-        }
-      }
-    }
-  }
-
   // What the cell's views observe: rays kRayStepRad apart to config.observe_range_m, through
   // unknown columns (optimistic), stopping at occupied ones.
   const CellSight& sight(int cell) {
@@ -316,6 +394,7 @@ class LookSearch {
     if (!s.way.empty()) return s;
     const int rays = static_cast<int>(std::lround(2.0 * M_PI / kRayStepRad));
     s.way.assign(at(rays), 0);
+    s.near.assign(at(rays), 0);
     s.any.assign(at(rays), 0);
     const Eigen::Vector2d from = place(cell);
     const double dr = 0.5 * columns_.res();
@@ -326,10 +405,11 @@ class LookSearch {
         if (!columns_.inside(i, j)) break;
         const std::size_t c = columns_.index(i, j);
         if (columns_.occupied(c)) break;
-        if (columns_.known(c) || stamp_[c] == cell) continue;
+        if (!columns_.toObserve(c) || stamp_[c] == cell) continue;
         stamp_[c] = cell;
         ++s.any[at(r)];
-        if (on_way_[c]) ++s.way[at(r)];
+        if (on_way_[c] >= 1) ++s.near[at(r)];
+        if (on_way_[c] == 2) ++s.way[at(r)];
       }
     }
     return s;
@@ -377,7 +457,7 @@ class LookSearch {
   std::vector<std::vector<std::uint8_t>> trackable_;  // per cell, per yaw (empty: not rated yet)
   std::vector<CellSight> sight_;                      // per cell (empty: not cast yet)
   std::vector<int> stamp_;                            // per column: the cell whose rays reached it last
-  std::vector<std::uint8_t> on_way_;                  // per column
+  std::vector<std::uint8_t> on_way_;                  // per column: 2 on the way on, 1 near it, 0
   std::vector<double> cost_;                          // per state
   std::vector<int> prev_;                             // per state
   std::vector<int> settled_;                          // in order of cost
@@ -396,20 +476,41 @@ bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_r
 }
 
 LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
-                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& way_on,
-                  const std::vector<Eigen::Vector3d>& visited, const std::vector<planner::Pose4>& looked,
-                  const std::vector<GuardEvent>& tripped, const LookConfig& config) {
+                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& route,
+                  const std::vector<Eigen::Vector3d>& way_on, const LookMemory& memory, const LookConfig& config) {
   LookPlan out;
-  LookSearch search(voxels, rater, start, visited, tripped, config);
+  LookSearch search(voxels, rater, start, memory, config);
   search.run();
   out.states = search.states();
   int target = search.reached(goal.head<2>());
   out.goal = target >= 0;
-  if (!out.goal) target = search.chooseLook(way_on, looked, &out);
+  Tier tier = Tier::kWay;
+  if (!out.goal) {
+    search.markWay(way_on);
+    // With advance, a look must observe at least the robot's footprint of unknown columns: less
+    // opens no way for it.
+    const double footprint = M_PI * config.robot_radius_m * config.robot_radius_m;
+    const int min_seen =
+        config.advance ? static_cast<int>(std::ceil(footprint / (voxels.resolution() * voxels.resolution()))) : 1;
+    target = search.chooseLook(Tier::kWay, min_seen, memory.looked, &out);
+    if (target < 0 && config.advance) {
+      target = search.advance(route, config.advance_min_m, memory.looked);
+      out.advance = target >= 0;
+      tier = Tier::kNear;
+      if (target < 0) target = search.chooseLook(tier, min_seen, memory.looked, &out);
+    }
+    if (target < 0 && !out.advance) {
+      tier = Tier::kAny;
+      target = search.chooseLook(tier, min_seen, memory.looked, &out);
+    }
+    out.way = target >= 0 && tier == Tier::kWay;
+    out.near = target >= 0 && tier == Tier::kNear && !out.advance;
+  }
   out.cells = search.cellsRated();
   if (target < 0) return out;
   out.cost_m = search.cost(target);
   out.path = search.pathTo(target);
+  if (!out.goal && !out.advance) out.watched = search.watched(target, tier);
   if (out.goal) {
     if (out.path.size() == 1) out.path.push_back(start);  // already in the goal's cell
     out.path.back().p_WB = Eigen::Vector3d(goal.x(), goal.y(), config.flight_height_m);

@@ -45,32 +45,57 @@ struct LookConfig {
   // between the last good yaw and the one that tripped it on, in the turn's direction, to
   // half_hfov_rad beyond it (where a view no longer shares any bearing with the tripped one).
   double tripped_m = 0.5;
+  // trial.look_advance, a goal-directed order of looks. A look must observe at least the robot's
+  // footprint of unknown columns (less opens no way for it). Where no view the search reaches
+  // observes that much of the way on, it flies along the route first: to the reached state farthest
+  // along the route's observed part, at least advance_min_m along it (the search's reach,
+  // max_cost_m, is shorter than most routes, and views of the way on lie closer from there). Where
+  // it cannot advance, it looks at unknown columns within near_m of the way on before any others.
+  // Chosen, not fitted: near_m is a few robot lengths.
+  bool advance = false;
+  double advance_min_m = 0.5;
+  double near_m = 2.0;
 };
 
 struct LookPlan {
   // From the start (as given) to the look pose: cell centres at the flight height, unwrapped yaws;
   // empty where no view observes anything unknown.
   std::vector<planner::Pose4> path;
-  int seen = 0;       // unknown cells (voxel columns) the look pose's view observes
-  bool way = false;   // ... of the way on (else: of any unknown space)
-  bool goal = false;  // the path ends at the goal instead (the search reached its cell)
+  int seen = 0;          // unknown cells (voxel columns) the look pose's view observes
+  bool way = false;      // ... of the way on (else: of any unknown space)
+  bool goal = false;     // the path ends at the goal instead (the search reached its cell)
+  bool advance = false;  // ... on the route, short of the way on (LookConfig::advance)
+  bool near = false;     // the look pose observes unknown columns near the way on (LookConfig::advance)
+  // The centres of the unknown columns the look pose's view observes (the `seen`; empty where the
+  // path ends at the goal or advances).
+  std::vector<Eigen::Vector2d> watched;
   double cost_m = 0.0;
   int states = 0;  // (cell, yaw) states the search settled
   int cells = 0;   // cells it rated views in
 };
 
+// What the flight so far tells the search (OnlinePlanning keeps it).
+struct LookMemory {
+  std::vector<Eigen::Vector3d> visited;  // places the vehicle has been
+  std::vector<planner::Pose4> looked;    // look poses flown to before
+  // Points in unknown columns that no longer count as unknown for what a view observes
+  // (trial.look_give_up: the looks flown to observe them did not).
+  std::vector<Eigen::Vector2d> given_up;
+  std::vector<GuardEvent> tripped;  // the tracking guard's trips
+};
+
 // The search on `voxels` (the plan's voxel map; its `observed` decides what is unknown), views
 // rated by `rater` (moved about by the search) with only the landmarks whose line of sight crosses
 // observed columns. Where it reaches the cell of `goal`, the path ends there (at the goal itself).
-// Else: `way_on` is the planner's route beyond where it first runs into unknown space; `visited`,
-// places the vehicle has been; `looked`, look poses flown to before. Among the states it reaches
-// whose view observes unknown cells of the way on (or, where none does, any unknown cells), it
-// takes the nearest (by the cost of moves and turns) of those that observe at least half as many
-// as the best; ties go to more seen, then the first settled.
+// Else: `route` is the planner's route from the start up to where it first runs into unknown
+// space, `way_on` the rest of it; `memory`, what the flight so far tells it. Among the states it
+// reaches whose view observes unknown cells of the way on, it takes the nearest (by the cost of
+// moves and turns) of those that observe at least half as many as the best; ties go to more seen,
+// then the first settled. Where none does, the same choice among views of any unknown cells; with
+// config.advance, first the advance and the views near the way on (LookConfig::advance).
 LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
-                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& way_on,
-                  const std::vector<Eigen::Vector3d>& visited, const std::vector<planner::Pose4>& looked,
-                  const std::vector<GuardEvent>& tripped, const LookConfig& config);
+                  const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& route,
+                  const std::vector<Eigen::Vector3d>& way_on, const LookMemory& memory, const LookConfig& config);
 
 // Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
 // tripped, from halfway through its turn to beyond_rad past the yaw that tripped it.

@@ -216,8 +216,11 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   rule.half_fov_rad = lookAheadHalfFov(perception);
   const std::vector<planner::Pose4> known = stopBeforeUnknown(a->run.plan.path, map, visited_, rule);
   const bool all_observed = known.size() >= a->run.plan.path.size();
+  std::vector<Eigen::Vector3d> route;
   std::vector<Eigen::Vector3d> way_on;
-  for (std::size_t i = known.size(); i < a->run.plan.path.size(); ++i) way_on.push_back(a->run.plan.path[i].p_WB);
+  for (std::size_t i = 0; i < a->run.plan.path.size(); ++i) {
+    (i < known.size() ? route : way_on).push_back(a->run.plan.path[i].p_WB);
+  }
   LookConfig look;
   look.robot_radius_m = perception.robot_radius_m;
   look.known_m = perception.robot_radius_m;  // the body never overlaps unknown space
@@ -228,19 +231,23 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
       scenario_.planner.trajectory.nominal_speed_mps / scenario_.planner.trajectory.nominal_yaw_rate_rad_s;
   look.visited_clear_m = clear_m;
   look.way_clear_m = clear_m;
+  look.advance = cfg_.look_advance;
   // The views it flies must expect trial.look_min_detections detections (150 by default, what the
   // tracking guard asks of inliers: the model fitted with the paper's line of sight alone rated views
   // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
   ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
   rater.setDetectionFloor(cfg_.look_min_detections);  // 0: none
-  const LookPlan found = planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, way_on,
-                                  visited_, looked_, result_.guards, look);
+  const LookMemory memory{visited_, looked_, givenUp(map.resolution()), result_.guards};
+  const LookPlan found =
+      planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, route, way_on, memory, look);
   a->record.look_cells = found.cells;
   // A route all observed that the search cannot fly with trackable views: flown as planned.
   if (all_observed && !found.goal) return false;
   a->record.look_seen = found.seen;
   a->record.look_way = found.way;
   a->record.look_goal = found.goal;
+  a->record.look_advance = found.advance;
+  a->record.look_near = found.near;
   if (found.path.size() < 2) {
     a->record.ok = false;
     a->record.detail =
@@ -252,7 +259,25 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   if (!smoothInto(from_here, "look_then_fly: ", a)) return true;
   a->stops_short = !found.goal;
   if (!found.goal) a->look = found.path.back();
+  a->watched = found.watched;
   return true;
+}
+
+void OnlinePlanning::noteLook(const Attempt& a) {
+  if (!a.look) return;
+  looked_.push_back(*a.look);
+  if (cfg_.look_give_up <= 0 || !a.map) return;
+  const double res = a.map->resolution();
+  for (const Eigen::Vector2d& c : a.watched) ++watch_count_[{std::lround(c.x() / res), std::lround(c.y() / res)}];
+}
+
+std::vector<Eigen::Vector2d> OnlinePlanning::givenUp(double resolution_m) const {
+  std::vector<Eigen::Vector2d> points;
+  if (cfg_.look_give_up <= 0) return points;
+  for (const auto& [key, n] : watch_count_) {
+    if (n >= cfg_.look_give_up) points.emplace_back(key.first * resolution_m, key.second * resolution_m);
+  }
+  return points;
 }
 
 OnlinePlanning::Attempt OnlinePlanning::planClearOf(const planner::Pose4& start, double t_s,
@@ -333,7 +358,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   if (a.trajectory && !cfg_.hold_first_plan) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
-    if (a.look) looked_.push_back(*a.look);
+    noteLook(a);
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));
     // Its views are rated as every flown plan's; their times count from the trajectory's start

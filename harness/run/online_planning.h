@@ -17,6 +17,7 @@
 // prior: an unseen surface gives the VO nothing) and prefers routes past what it has seen textured.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -75,9 +76,11 @@ struct OnlinePlan {
   int look_seen = -1;
   bool look_way = false;
   bool look_goal = false;
-  int look_cells = 0;       // cells whose views the search rated
-  int landmarks = 0;        // in the map it planned on
-  int prior_landmarks = 0;  // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
+  bool look_advance = false;  // trial.look_advance: it flew along the route instead (LookPlan::advance)
+  bool look_near = false;     // ... it looked near the way on (LookPlan::near)
+  int look_cells = 0;         // cells whose views the search rated
+  int landmarks = 0;          // in the map it planned on
+  int prior_landmarks = 0;    // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
   // trial.unseen_prior route_mean: the class the plan on the map with the mean prior chose, which
   // this plan then flies (-1: none, or not asked)
   int rated_class = -1;
@@ -200,6 +203,10 @@ class OnlinePlanning {
   // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
   // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
   bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
+  // An adopted plan's look pose: not chosen again, and its columns counted (watch_count_).
+  void noteLook(const Attempt& a);
+  // The columns trial.look_give_up looks were to observe (their centres).
+  std::vector<Eigen::Vector2d> givenUp(double resolution_m) const;
   // trial.stop_before_unknown: a's path (and trajectory) end before they run into unknown space;
   // false where that trajectory cannot be made (a->record says why).
   bool stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
@@ -261,6 +268,9 @@ class OnlinePlanning {
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
+  // ... per unknown column (its centre, in units of the map's resolution), how many look poses
+  // adopted were to observe it (trial.look_give_up).
+  std::map<std::pair<long, long>, int> watch_count_;
   OnlineResult result_;
 };
 
@@ -271,8 +281,9 @@ struct OnlinePlanning::Attempt {
   std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
   std::optional<control::SetpointTrajectory> raw;         // the planner's
   std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
-  bool stops_short = false;            // its trajectory ends before the path does (stop_before_unknown)
-  std::optional<planner::Pose4> look;  // trial.look_then_fly: its trajectory ends at this look pose
+  bool stops_short = false;              // its trajectory ends before the path does (stop_before_unknown)
+  std::optional<planner::Pose4> look;    // trial.look_then_fly: its trajectory ends at this look pose
+  std::vector<Eigen::Vector2d> watched;  // ... whose view is to observe these unknown columns (centres)
 };
 
 }  // namespace tgnav::harness

@@ -126,7 +126,7 @@ std::string OnlinePlanning::takeTrigger() {
 void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool before_start) {
   a->record.adopted = true;
   stops_short_ = a->stops_short;
-  if (a->look) looked_.push_back(*a->look);
+  noteLook(*a);
   last_change_s_ = a->record.t_s;
   switchTo(*a->trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
   rateFlownViews(a->raw ? &*a->raw : nullptr, true, tau_switch, t_switch, a);

@@ -45,7 +45,8 @@ bool observedFree(const planner::VoxelMap& voxels, const Eigen::Vector3d& p) {
 TEST(LookThenFly, FliesToAGoalInObservedSpaceWithEveryViewTrackable) {
   Room room(3.4);
   const Eigen::Vector3d goal(2.5, 0.5, kHeight);
-  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, {}, {kStart.p_WB}, {}, {}, config());
+  const LookPlan plan =
+      planLook(room.voxels, room.rater, kStart, goal, {}, {}, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   ASSERT_TRUE(plan.goal);
   ASSERT_GE(plan.path.size(), 2U);
   EXPECT_EQ(plan.path.front().p_WB, kStart.p_WB);
@@ -65,7 +66,8 @@ TEST(LookThenFly, LooksAtTheUnknownWayOnFromAViewThatKeepsTheWallInSight) {
   const Eigen::Vector3d goal(2.5, 3.5, kHeight);
   std::vector<Eigen::Vector3d> way_on;
   for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
-  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, way_on, {kStart.p_WB}, {}, {}, config());
+  const LookPlan plan =
+      planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   ASSERT_FALSE(plan.goal);
   ASSERT_GE(plan.path.size(), 2U);
   EXPECT_TRUE(plan.way);
@@ -84,18 +86,98 @@ TEST(LookThenFly, LooksAtTheUnknownWayOnFromAViewThatKeepsTheWallInSight) {
   std::cout << "[ figure   ] look pose (" << look.p_WB.x() << ", " << look.p_WB.y() << ") yaw " << yaw / kDeg
             << " deg sees " << plan.seen << " unknown cells of the way on, cost " << plan.cost_m << " m\n";
   // Flown there, it is not chosen again.
-  const LookPlan again = planLook(room.voxels, room.rater, kStart, goal, way_on, {kStart.p_WB}, {look}, {}, config());
+  const LookPlan again =
+      planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {look}, {}, {}}, config());
   ASSERT_GE(again.path.size(), 2U);
   const planner::Pose4& other = again.path.back();
   EXPECT_TRUE((other.p_WB - look.p_WB).head<2>().norm() > 0.3 ||
               std::abs(std::remainder(other.yaw_rad - look.yaw_rad, 2.0 * M_PI)) > 16.0 * kDeg);
 }
 
+TEST(LookThenFly, AdvancesAlongTheRouteWhereNoReachedViewObservesTheWayOn) {
+  Room room(3.4);
+  // The way on runs behind the wall (x > 3.55, level with it): every line of sight to it crosses
+  // the wall. The route's observed part runs east from the start.
+  const Eigen::Vector3d goal(4.2, -1.0, kHeight);
+  const std::vector<Eigen::Vector3d> route{kStart.p_WB, Eigen::Vector3d(2.6, 0.0, kHeight)};
+  std::vector<Eigen::Vector3d> way_on;
+  for (double y = 0.0; y >= -1.0; y -= 0.2) way_on.emplace_back(4.2, y, kHeight);
+  // Without the option it looks at other unknown space.
+  const LookPlan look =
+      planLook(room.voxels, room.rater, kStart, goal, route, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
+  ASSERT_GE(look.path.size(), 2U);
+  EXPECT_FALSE(look.way);
+  EXPECT_FALSE(look.advance);
+  EXPECT_GT(look.seen, 0);
+  LookConfig c = config();
+  c.advance = true;
+  const LookPlan plan =
+      planLook(room.voxels, room.rater, kStart, goal, route, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, c);
+  ASSERT_GE(plan.path.size(), 2U);
+  EXPECT_TRUE(plan.advance);
+  EXPECT_FALSE(plan.goal);
+  EXPECT_FALSE(plan.way);
+  EXPECT_LT((plan.path.back().p_WB - route.back()).head<2>().norm(), c.cell_m) << plan.path.back().p_WB.transpose();
+  for (const planner::Pose4& p : plan.path) {
+    EXPECT_TRUE(observedFree(room.voxels, p.p_WB)) << p.p_WB.transpose();
+    room.rater.moveTo(p.p_WB);
+    EXPECT_EQ(room.rater.shortfall(p.yaw_rad), 0.0) << p.p_WB.transpose() << " yaw " << p.yaw_rad;
+  }
+  std::cout << "[ figure   ] advanced to (" << plan.path.back().p_WB.x() << ", " << plan.path.back().p_WB.y()
+            << "), cost " << plan.cost_m << " m; without the option the look pose was (" << look.path.back().p_WB.x()
+            << ", " << look.path.back().p_WB.y() << ")\n";
+  // Flown there, it is not chosen again: the next cell back along the route is.
+  const LookPlan again = planLook(room.voxels, room.rater, kStart, goal, route, way_on,
+                                  LookMemory{{kStart.p_WB}, {plan.path.back()}, {}, {}}, c);
+  ASSERT_TRUE(again.advance);
+  EXPECT_NE(again.path.back().p_WB, plan.path.back().p_WB);
+  // A route observed for less than advance_min_m: no advance, but a view of the unknown space near
+  // the way on (south of the wall's end), not of any.
+  const std::vector<Eigen::Vector3d> short_route{kStart.p_WB, kStart.p_WB + Eigen::Vector3d(0.3, 0.0, 0.0)};
+  const LookPlan other =
+      planLook(room.voxels, room.rater, kStart, goal, short_route, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, c);
+  EXPECT_FALSE(other.advance);
+  ASSERT_TRUE(other.near);
+  ASSERT_FALSE(other.watched.empty());
+  for (const Eigen::Vector2d& w : other.watched) {
+    EXPECT_TRUE(std::any_of(way_on.begin(), way_on.end(), [&](const Eigen::Vector3d& p) {
+      return (p.head<2>() - w).norm() <= c.near_m + 1e-9;
+    })) << w.transpose();
+  }
+  EXPECT_GE(other.seen, static_cast<int>(std::ceil(M_PI * c.robot_radius_m * c.robot_radius_m /
+                                                   std::pow(room.voxels.resolution(), 2))));
+}
+
+TEST(LookThenFly, ColumnsGivenUpNoLongerDrawALook) {
+  Room room(3.4);
+  const Eigen::Vector3d goal(2.5, 3.5, kHeight);
+  std::vector<Eigen::Vector3d> way_on;
+  for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
+  const LookPlan first =
+      planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
+  ASSERT_TRUE(first.way);
+  ASSERT_GE(first.watched.size(), static_cast<std::size_t>(first.seen));
+  for (const Eigen::Vector2d& c : first.watched) {
+    EXPECT_FALSE(room.voxels.observed(Eigen::Vector3d(c.x(), c.y(), kHeight))) << c.transpose();
+  }
+  // Given up on, the columns it watched count for no view: the next look watches others.
+  const LookPlan next = planLook(room.voxels, room.rater, kStart, goal, {}, way_on,
+                                 LookMemory{{kStart.p_WB}, {}, first.watched, {}}, config());
+  for (const Eigen::Vector2d& c : next.watched) {
+    EXPECT_TRUE(std::none_of(first.watched.begin(), first.watched.end(), [&](const Eigen::Vector2d& w) {
+      return (w - c).norm() < 1e-9;
+    })) << c.transpose();
+  }
+  std::cout << "[ figure   ] the first look watches " << first.watched.size() << " columns (" << first.seen
+            << " of the way on by its rays); with those given up the next watches " << next.watched.size() << "\n";
+}
+
 TEST(LookThenFly, FindsNothingWhereNoViewIsTrackable) {
   Room bare(3.4, false);
   const Eigen::Vector3d goal(2.5, 3.5, kHeight);
   const std::vector<Eigen::Vector3d> way_on{Eigen::Vector3d(2.5, 2.0, kHeight)};
-  const LookPlan plan = planLook(bare.voxels, bare.rater, kStart, goal, way_on, {kStart.p_WB}, {}, {}, config());
+  const LookPlan plan =
+      planLook(bare.voxels, bare.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   EXPECT_TRUE(plan.path.empty());
   EXPECT_FALSE(plan.goal);
   EXPECT_EQ(plan.states, 1);  // the start alone: no other view is trackable
@@ -109,7 +191,8 @@ TEST(LookThenFly, CountsNoLandmarkAcrossUnknownSpace) {
   room.rater.moveTo(Eigen::Vector3d(1.0, 0.0, kHeight));
   ASSERT_EQ(room.rater.shortfall(0.0), 0.0);
   const Eigen::Vector3d goal(1.5, 0.0, kHeight);
-  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, {}, {kStart.p_WB}, {}, {}, config());
+  const LookPlan plan =
+      planLook(room.voxels, room.rater, kStart, goal, {}, {}, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   EXPECT_FALSE(plan.goal);
   EXPECT_TRUE(plan.path.empty());
 }
@@ -144,9 +227,10 @@ TEST(LookThenFly, ViewsTheGuardTrippedOnAreRuledOutNearWhereItTripped) {
     });
   };
   // Without the trip the look pose is one of those views.
-  ASSERT_TRUE(tripped(planLook(room.voxels, room.rater, kStart, goal, way_on, {kStart.p_WB}, {}, {}, config())));
-  const LookPlan plan =
-      planLook(room.voxels, room.rater, kStart, goal, way_on, {kStart.p_WB}, {}, {at_start}, config());
+  ASSERT_TRUE(tripped(
+      planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config())));
+  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, {}, way_on,
+                                 LookMemory{{kStart.p_WB}, {}, {}, {at_start}}, config());
   ASSERT_GE(plan.path.size(), 2U);
   EXPECT_FALSE(tripped(plan));
   for (const planner::Pose4& p : plan.path) {
