@@ -162,6 +162,12 @@ struct OnlineConfig {
   // inside obstacles, behind walls and seen through the map's holes stay unknown however often
   // they are looked at: on detour-5002 the explorer flew back 5 m, again and again, to a view of 4.
   int look_give_up = 0;
+  // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
+  // the detection floor drops to guard_inliers times the detections the model expects of the
+  // current view over its inliers, where that is lower (LookConfig::tracked_inliers): the model
+  // counts only the landmarks mapped so far. false: look_min_detections as set (on detour-5006 the
+  // vehicle never left its start, tracking 700-900 inliers, with no view rated above the floor).
+  bool look_calibrate_floor = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
@@ -227,6 +233,7 @@ struct OnlineConfig {
     a("look_min_detections", look_min_detections);
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
+    a("look_calibrate_floor", look_calibrate_floor);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);

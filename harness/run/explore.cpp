@@ -337,6 +337,18 @@ class LookSearch {
     return path;
   }
 
+  // LookConfig::tracked_inliers: lowers the rater's floor to what the current view calibrates;
+  // returns the floor in force.
+  double calibrateFloor() {
+    const double floor = rater_.detectionFloor();
+    if (config_.tracked_inliers <= 0 || floor <= 0.0) return floor;
+    rateFrom(start_.p_WB.head<2>());
+    const double expected = rater_.detections(start_.yaw_rad);
+    const double calibrated = config_.floor_inliers * expected / config_.tracked_inliers;
+    if (calibrated < floor) rater_.setDetectionFloor(calibrated);
+    return rater_.detectionFloor();
+  }
+
   double cost(int state) const { return cost_[at(state)]; }
   int states() const { return static_cast<int>(settled_.size()); }
   int cellsRated() const { return cells_rated_; }
@@ -366,16 +378,21 @@ class LookSearch {
     return c == 1;
   }
 
+  // The rater moved to c: a landmark counts only where the way to it runs through observed space
+  // (the voxel map's line of sight passes through unknown space, where a surface not yet mapped may
+  // hide it).
+  void rateFrom(const Eigen::Vector2d& c) {
+    rater_.moveTo(Eigen::Vector3d(c.x(), c.y(), config_.flight_height_m), [&](const planner::LandmarkVoxel& v) {
+      return columns_.knownLine(c, v.centre_W.head<2>(), kSurfaceEndM);
+    });
+  }
+
   // Per yaw, whether the view from the cell rates trackable (and the guard did not trip on it).
   const std::vector<std::uint8_t>& trackable(int cell) {
     std::vector<std::uint8_t>& t = trackable_[at(cell)];
     if (!t.empty()) return t;
     const Eigen::Vector2d c = place(cell);
-    // A landmark counts only where the way to it runs through observed space: the voxel map's line
-    // of sight passes through unknown space, where a surface not yet mapped may hide it.
-    rater_.moveTo(Eigen::Vector3d(c.x(), c.y(), config_.flight_height_m), [&](const planner::LandmarkVoxel& v) {
-      return columns_.knownLine(c, v.centre_W.head<2>(), kSurfaceEndM);
-    });
+    rateFrom(c);
     t.resize(at(yaws_));
     for (int k = 0; k < yaws_; ++k) {
       const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
@@ -480,6 +497,7 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
                   const std::vector<Eigen::Vector3d>& way_on, const LookMemory& memory, const LookConfig& config) {
   LookPlan out;
   LookSearch search(voxels, rater, start, memory, config);
+  out.floor = search.calibrateFloor();
   search.run();
   out.states = search.states();
   int target = search.reached(goal.head<2>());

@@ -55,6 +55,13 @@ struct LookConfig {
   bool advance = false;
   double advance_min_m = 0.5;
   double near_m = 2.0;
+  // trial.look_calibrate_floor: > 0, the inliers the VO tracks the current view with. The rater
+  // expects fewer detections than the VO finds inliers (it counts only mapped landmarks, through
+  // observed space); a view it expects to give the current view's detections times floor_inliers /
+  // tracked_inliers is taken to keep floor_inliers, so the detection floor drops to that, where it
+  // is lower (never raised). 0: the floor as set.
+  int tracked_inliers = 0;
+  int floor_inliers = 150;
 };
 
 struct LookPlan {
@@ -70,8 +77,9 @@ struct LookPlan {
   // path ends at the goal or advances).
   std::vector<Eigen::Vector2d> watched;
   double cost_m = 0.0;
-  int states = 0;  // (cell, yaw) states the search settled
-  int cells = 0;   // cells it rated views in
+  int states = 0;      // (cell, yaw) states the search settled
+  int cells = 0;       // cells it rated views in
+  double floor = 0.0;  // the detection floor the views were rated with (LookConfig::tracked_inliers)
 };
 
 // What the flight so far tells the search (OnlinePlanning keeps it).

@@ -35,6 +35,13 @@ double ViewRater::shortfall(double yaw_rad) const {
   return std::max(gates, 1.0 - support.detections / detection_floor_);
 }
 
+double ViewRater::detections(double yaw_rad) const {
+  planner::ViewSupport support;
+  planner::poseInformation(planner::cameraPosition(p_WB_, yaw_rad, *visibility_), yaw_rad, points_, *visibility_,
+                           *information_, &support);
+  return support.detections;
+}
+
 double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit) {
   const double turn = std::remainder(look - planned, 2.0 * M_PI);
   const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(turn) / kYawStepRad)));

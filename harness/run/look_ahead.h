@@ -42,6 +42,9 @@ class ViewRater {
   // A gate on top of the model's (or the configured gates): a view expecting fewer than this many
   // detections (planner::ViewSupport::detections) falls short by 1 - detections / floor.
   void setDetectionFloor(double detections) { detection_floor_ = detections; }
+  double detectionFloor() const { return detection_floor_; }
+  // The detections the model expects of the view along yaw_rad (planner::ViewSupport::detections).
+  double detections(double yaw_rad) const;
 
  private:
   const planner::VoxelMap* voxels_;

@@ -78,6 +78,7 @@ struct OnlinePlan {
   bool look_goal = false;
   bool look_advance = false;  // trial.look_advance: it flew along the route instead (LookPlan::advance)
   bool look_near = false;     // ... it looked near the way on (LookPlan::near)
+  double look_floor = -1.0;   // ... the detection floor its views were rated with (LookPlan::floor)
   int look_cells = 0;         // cells whose views the search rated
   int landmarks = 0;          // in the map it planned on
   int prior_landmarks = 0;    // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
@@ -271,6 +272,7 @@ class OnlinePlanning {
   // ... per unknown column (its centre, in units of the map's resolution), how many look poses
   // adopted were to observe it (trial.look_give_up).
   std::map<std::pair<long, long>, int> watch_count_;
+  int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
   OnlineResult result_;
 };
 

@@ -96,6 +96,7 @@ void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double ta
 }
 
 void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame) {
+  last_inliers_ = frame.inliers;
   if (!guard_ || t_s < trajectory_start_s) return;
   const Eigen::Isometry3d& X_WC = frame.X_WC;
   const int inliers = frame.inliers;

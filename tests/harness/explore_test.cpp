@@ -172,6 +172,36 @@ TEST(LookThenFly, ColumnsGivenUpNoLongerDrawALook) {
             << " of the way on by its rays); with those given up the next watches " << next.watched.size() << "\n";
 }
 
+TEST(LookThenFly, TheFloorCalibratedOnTheTrackedViewLetsItMove) {
+  Room room(3.4);
+  room.rater.moveTo(kStart.p_WB);
+  const double expected = room.rater.detections(kStart.yaw_rad);
+  ASSERT_GT(expected, 0.0);
+  // A floor no view reaches: held at the start.
+  room.rater.setDetectionFloor(10.0 * expected);
+  const Eigen::Vector3d goal(2.5, 0.5, kHeight);
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {}};
+  const LookPlan held = planLook(room.voxels, room.rater, kStart, goal, {}, {}, memory, config());
+  EXPECT_FALSE(held.goal);
+  EXPECT_EQ(held.states, 1);
+  EXPECT_EQ(held.floor, 10.0 * expected);
+  // The VO tracks the start's view with 4 times the guard's inliers: the floor drops to a quarter
+  // of what the model expects there, and the goal is reached.
+  room.rater.setDetectionFloor(10.0 * expected);
+  LookConfig c = config();
+  c.floor_inliers = 150;
+  c.tracked_inliers = 600;
+  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, {}, {}, memory, c);
+  EXPECT_NEAR(plan.floor, 0.25 * expected, 1e-9);
+  EXPECT_TRUE(plan.goal);
+  // Never raised: a low floor stays.
+  room.rater.setDetectionFloor(1.0);
+  EXPECT_EQ(planLook(room.voxels, room.rater, kStart, goal, {}, {}, memory, c).floor, 1.0);
+  std::cout << "[ figure   ] the model expects " << expected << " detections of the start's view; floor "
+            << 10.0 * expected << " holds it (" << held.states << " state), calibrated " << plan.floor
+            << " reaches the goal\n";
+}
+
 TEST(LookThenFly, FindsNothingWhereNoViewIsTrackable) {
   Room bare(3.4, false);
   const Eigen::Vector3d goal(2.5, 3.5, kHeight);
