@@ -285,6 +285,26 @@ TEST(OnlineTrial, LookThenFlyHoldsUntilAViewCanBeFlownAndNeverFliesWhereItsMapIs
   }
   const nlohmann::json metrics = readJson(dir / "look/metrics.json");
   EXPECT_TRUE(metrics["collision"].is_null());
+  // The goal-directed looks and the calibrated floor (not adopted; docs/results/advance): the floor
+  // is 150 until the VO has tracked a frame, then never above it.
+  ASSERT_EQ(shell(trialCommand(args +
+                               " --set trial.look_advance=true --set trial.look_give_up=2"
+                               " --set trial.look_calibrate_floor=true --out " +
+                               (dir / "advance").string()))
+                .rc,
+            0);
+  const nlohmann::json advance = readJson(dir / "advance/online.json")["plans"];
+  ASSERT_GE(advance.size(), 2U);
+  EXPECT_EQ(advance[0]["look_floor"], 150.0);
+  for (std::size_t i = 1; i < advance.size(); ++i) {
+    std::cout << "[ figure   ] goal-directed plan at " << advance[i]["t_s"] << " s: floor " << advance[i]["look_floor"]
+              << ", advance " << advance[i]["look_advance"] << ", near " << advance[i]["look_near"] << ", sees "
+              << advance[i]["look_seen"] << "\n";
+    if (advance[i]["look_seen"].get<int>() >= 0) {
+      EXPECT_LE(advance[i]["look_floor"].get<double>(), 150.0);
+    }
+  }
+  EXPECT_TRUE(readJson(dir / "advance/metrics.json")["collision"].is_null());
   ASSERT_GE(ap.size(), 1U);
   EXPECT_TRUE(ap[0]["ok"].get<bool>());
   EXPECT_EQ(ap[0]["look_seen"], -1);
