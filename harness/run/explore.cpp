@@ -291,6 +291,7 @@ class LookSearch {
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
     std::vector<Eigen::Vector2d> centres;
+    centres.reserve(columns.size());
     for (const std::size_t c : columns) {
       centres.push_back(columns_.centre(static_cast<int>(c % columns_.nx()), static_cast<int>(c / columns_.nx())));
     }
