@@ -239,7 +239,7 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
   ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
   rater.setDetectionFloor(cfg_.look_min_detections);  // 0: none
-  const LookMemory memory{visited_, looked_, givenUp(map.resolution()), result_.guards};
+  const LookMemory memory{visited_, looked_, givenUp(), result_.guards};
   const LookPlan found =
       planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, route, way_on, memory, look);
   a->record.look_cells = found.cells;
@@ -271,14 +271,17 @@ void OnlinePlanning::noteLook(const Attempt& a) {
   looked_.push_back(*a.look);
   if (cfg_.look_give_up <= 0 || !a.map) return;
   const double res = a.map->resolution();
-  for (const Eigen::Vector2d& c : a.watched) ++watch_count_[{std::lround(c.x() / res), std::lround(c.y() / res)}];
+  for (const Eigen::Vector2d& c : a.watched) {
+    const std::pair<long, long> key{std::lround(std::floor(c.x() / res)), std::lround(std::floor(c.y() / res))};
+    ++watch_count_.try_emplace(key, c, 0).first->second.second;  // the first centre seen stays
+  }
 }
 
-std::vector<Eigen::Vector2d> OnlinePlanning::givenUp(double resolution_m) const {
+std::vector<Eigen::Vector2d> OnlinePlanning::givenUp() const {
   std::vector<Eigen::Vector2d> points;
   if (cfg_.look_give_up <= 0) return points;
-  for (const auto& [key, n] : watch_count_) {
-    if (n >= cfg_.look_give_up) points.emplace_back(key.first * resolution_m, key.second * resolution_m);
+  for (const auto& [key, watch] : watch_count_) {
+    if (watch.second >= cfg_.look_give_up) points.push_back(watch.first);
   }
   return points;
 }

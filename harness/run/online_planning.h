@@ -207,7 +207,7 @@ class OnlinePlanning {
   // An adopted plan's look pose: not chosen again, and its columns counted (watch_count_).
   void noteLook(const Attempt& a);
   // The columns trial.look_give_up looks were to observe (their centres).
-  std::vector<Eigen::Vector2d> givenUp(double resolution_m) const;
+  std::vector<Eigen::Vector2d> givenUp() const;
   // trial.stop_before_unknown: a's path (and trajectory) end before they run into unknown space;
   // false where that trajectory cannot be made (a->record says why).
   bool stopShort(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
@@ -269,9 +269,9 @@ class OnlinePlanning {
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
-  // ... per unknown column (its centre, in units of the map's resolution), how many look poses
-  // adopted were to observe it (trial.look_give_up).
-  std::map<std::pair<long, long>, int> watch_count_;
+  // ... per unknown column (keyed by its centre's cell on the map's resolution): its centre, and how
+  // many look poses adopted were to observe it (trial.look_give_up).
+  std::map<std::pair<long, long>, std::pair<Eigen::Vector2d, int>> watch_count_;
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
   OnlineResult result_;
 };
