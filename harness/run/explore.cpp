@@ -29,8 +29,9 @@ struct CellSight {
   std::vector<int> any;
 };
 
-// Which unknown columns a look counts: of the way on, near it, or any.
-enum class Tier { kWay, kNear, kAny };
+// Which unknown columns a look counts: any, near the way on, or of the way on (the levels of
+// LookSearch's on_way_).
+enum class Tier : std::uint8_t { kAny = 0, kNear = 1, kWay = 2 };
 
 // The search of planLook() over (cell, yaw) states: state = cell * yaws + yaw index.
 class LookSearch {
@@ -185,7 +186,7 @@ class LookSearch {
     const int rays = static_cast<int>(std::lround(2.0 * M_PI / kRayStepRad));
     const int half = static_cast<int>(std::floor(config_.half_hfov_rad / kRayStepRad));
     const int mid = static_cast<int>(std::lround(yawOf(state % yaws_) / kRayStepRad));
-    const int needed = tier == Tier::kWay ? 2 : tier == Tier::kNear ? 1 : 0;
+    const auto needed = static_cast<std::uint8_t>(tier);
     const double dr = 0.5 * columns_.res();
     std::vector<std::size_t> columns;
     for (int r = mid - half; r <= mid + half; ++r) {
@@ -222,7 +223,8 @@ class LookSearch {
           const double d = (columns_.centre(i, j) - p.head<2>()).norm();
           const std::size_t c = columns_.index(i, j);
           if (d > near_m || columns_.known(c) || columns_.occupied(c)) continue;
-          on_way_[c] = std::max<std::uint8_t>(on_way_[c], d <= config_.way_clear_m ? 2 : 1);
+          const Tier tier = d <= config_.way_clear_m ? Tier::kWay : Tier::kNear;
+          on_way_[c] = std::max(on_way_[c], static_cast<std::uint8_t>(tier));
         }
       }
     }
@@ -337,8 +339,8 @@ class LookSearch {
         if (!columns_.toObserve(c) || stamp_[c] == cell) continue;
         stamp_[c] = cell;
         ++s.any[at(r)];
-        if (on_way_[c] >= 1) ++s.near[at(r)];
-        if (on_way_[c] == 2) ++s.way[at(r)];
+        if (on_way_[c] >= static_cast<std::uint8_t>(Tier::kNear)) ++s.near[at(r)];
+        if (on_way_[c] == static_cast<std::uint8_t>(Tier::kWay)) ++s.way[at(r)];
       }
     }
     return s;
@@ -386,7 +388,7 @@ class LookSearch {
   std::vector<std::vector<std::uint8_t>> trackable_;  // per cell, per yaw (empty: not rated yet)
   std::vector<CellSight> sight_;                      // per cell (empty: not cast yet)
   std::vector<int> stamp_;                            // per column: the cell whose rays reached it last
-  std::vector<std::uint8_t> on_way_;                  // per column: 2 on the way on, 1 near it, 0
+  std::vector<std::uint8_t> on_way_;                  // per column: its Tier (kAny: neither near nor on)
   std::vector<double> cost_;                          // per state
   std::vector<int> prev_;                             // per state
   std::vector<int> settled_;                          // in order of cost

@@ -38,6 +38,14 @@ LookConfig config() {
 
 const planner::Pose4 kStart{Eigen::Vector3d(0.6, 0.0, kHeight), 0.0};  // facing the wall
 
+// A goal north, beyond the observed room (y >= 1 is unknown), and the way on that runs there.
+const Eigen::Vector3d kNorthGoal(2.5, 3.5, kHeight);
+std::vector<Eigen::Vector3d> northWayOn() {
+  std::vector<Eigen::Vector3d> way_on;
+  for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
+  return way_on;
+}
+
 bool observedFree(const planner::VoxelMap& voxels, const Eigen::Vector3d& p) {
   return voxels.observed(p) && voxels.state(p) == planner::VoxelState::kFree;
 }
@@ -63,9 +71,8 @@ TEST(LookThenFly, FliesToAGoalInObservedSpaceWithEveryViewTrackable) {
 TEST(LookThenFly, LooksAtTheUnknownWayOnFromAViewThatKeepsTheWallInSight) {
   Room room(3.4);
   // The goal lies north, beyond the observed room (y >= 1 is unknown): the way on runs there.
-  const Eigen::Vector3d goal(2.5, 3.5, kHeight);
-  std::vector<Eigen::Vector3d> way_on;
-  for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
+  const Eigen::Vector3d goal = kNorthGoal;
+  const std::vector<Eigen::Vector3d> way_on = northWayOn();
   const LookPlan plan =
       planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   ASSERT_FALSE(plan.goal);
@@ -150,9 +157,8 @@ TEST(LookThenFly, AdvancesAlongTheRouteWhereNoReachedViewObservesTheWayOn) {
 
 TEST(LookThenFly, ColumnsGivenUpNoLongerDrawALook) {
   Room room(3.4);
-  const Eigen::Vector3d goal(2.5, 3.5, kHeight);
-  std::vector<Eigen::Vector3d> way_on;
-  for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
+  const Eigen::Vector3d goal = kNorthGoal;
+  const std::vector<Eigen::Vector3d> way_on = northWayOn();
   const LookPlan first =
       planLook(room.voxels, room.rater, kStart, goal, {}, way_on, LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
   ASSERT_TRUE(first.way);
@@ -248,9 +254,8 @@ TEST(LookThenFly, ViewsTheGuardTrippedOnAreRuledOutNearWhereItTripped) {
   at_start.good_yaw_rad = 0.0;
   at_start.yaw_rad = 0.4;
   at_start.wedge.apex = kStart.p_WB;
-  const Eigen::Vector3d goal(2.5, 3.5, kHeight);
-  std::vector<Eigen::Vector3d> way_on;
-  for (double y = 1.2; y <= 3.5; y += 0.2) way_on.emplace_back(2.5, y, kHeight);
+  const Eigen::Vector3d goal = kNorthGoal;
+  const std::vector<Eigen::Vector3d> way_on = northWayOn();
   const auto tripped = [&](const LookPlan& plan) {
     return std::any_of(plan.path.begin(), plan.path.end(), [&](const planner::Pose4& p) {
       return trippedView(at_start, p.p_WB.head<2>(), p.yaw_rad, config().tripped_m, config().half_hfov_rad);
