@@ -96,6 +96,10 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
   }
+  if (look_probe && !look_advance) {
+    throw std::invalid_argument(
+        "look_probe = true: needs look_advance = true (it probes where the vehicle cannot advance)");
+  }
   require(look_give_up >= 0 && look_give_up <= 1000, "look_give_up", look_give_up, "must be in [0, 1000]");
   require(std::isfinite(look_min_detections) && look_min_detections >= 0.0 && look_min_detections <= 10000.0,
           "look_min_detections", look_min_detections, "must be in [0, 10000]");

@@ -162,6 +162,12 @@ struct OnlineConfig {
   // inside obstacles, behind walls and seen through the map's holes stay unknown however often
   // they are looked at: on detour-5002 the explorer flew back 5 m, again and again, to a view of 4.
   int look_give_up = 0;
+  // With look_advance: where no trackable view observes the way on and the vehicle cannot advance,
+  // it turns to the view of the way on that the model rates least short, trackable or not, and leaves
+  // it to the tracking guard (LookConfig::probe; meant with guard_tracking). false: it looks near the
+  // way on, then anywhere (on the premise scenes, the flights that timed out did so 1.2-2 m short of
+  // where their route ran into space not yet observed: docs/results/advance).
+  bool look_probe = false;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the
   // current view over its inliers, where that is lower (LookConfig::tracked_inliers): the model
@@ -233,6 +239,7 @@ struct OnlineConfig {
     a("look_min_detections", look_min_detections);
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
+    a("look_probe", look_probe);
     a("look_calibrate_floor", look_calibrate_floor);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "harness/run/look_columns.h"
+#include "planner/covisibility.h"
 
 namespace tgnav::harness {
 
@@ -18,6 +19,7 @@ constexpr double kRayStepRad = 2.0 * M_PI / 180.0;  // the rays a cell's views a
 // The last stretch of a line of sight to a landmark's voxel that may cross unknown columns (the
 // surface's own voxel, and the one before it that depth seldom fills).
 constexpr double kSurfaceEndM = 0.2;
+constexpr float kRuledOut = 2.0F;  // a view the guard's trips rule out (shortfalls are at most 1)
 
 double wrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
@@ -52,6 +54,7 @@ class LookSearch {
     const std::size_t cells = static_cast<std::size_t>(gx_) * gy_;
     clear_.assign(cells, -1);
     trackable_.resize(cells);
+    shortfall_.resize(cells);
     sight_.resize(cells);
     stamp_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), -1);
     const Eigen::Vector2d s = start.p_WB.head<2>();
@@ -177,6 +180,44 @@ class LookSearch {
     }
     out->seen = seen[at(chosen)];
     return settled_[at(chosen)];
+  }
+
+  // LookConfig::probe: among the cells reached, the view of at least min_seen unknown columns of the
+  // way on, not ruled out by the guard, not flown to before and not the start's own, that the model
+  // rates least short (at a tie, the nearer). Returns that (cell, yaw) state, sets *from to the
+  // least-cost state reached in its cell and out->seen; -1: none. markWay() first.
+  int probe(int min_seen, const std::vector<planner::Pose4>& looked, int* from, LookPlan* out) {
+    std::vector<std::uint8_t> asked(static_cast<std::size_t>(gx_) * gy_, 0);
+    int chosen = -1;
+    float least = kRuledOut;
+    for (const int s : settled_) {  // in order of cost: the first state in a cell is its nearest
+      const int cell = s / yaws_;
+      if (asked[at(cell)]) continue;
+      asked[at(cell)] = 1;
+      trackable(cell);
+      const CellSight& cs = sight(cell);
+      for (int k = 0; k < yaws_; ++k) {
+        const int view = cell * yaws_ + k;
+        const float short_by = shortfall_[at(cell)][at(k)];
+        if (short_by >= least || view == start_state_ || repeats(view, looked)) continue;
+        const int seen = seenAlong(cs.way, yawOf(k));
+        if (seen < min_seen) continue;
+        chosen = view;
+        least = short_by;
+        *from = s;
+        out->seen = seen;
+      }
+    }
+    return chosen;
+  }
+
+  // The path to `from` (pathTo()), then a turn where it ends to the yaw of `view` (in its cell).
+  std::vector<planner::Pose4> pathTurningTo(int from, int view) const {
+    std::vector<planner::Pose4> path = pathTo(from);
+    planner::Pose4 turned = path.back();
+    turned.yaw_rad += wrapAngle(yawOf(view % yaws_) - turned.yaw_rad);
+    path.push_back(turned);
+    return path;
   }
 
   // The centres of the columns of `tier` the view of `state` counts (sight()).
@@ -308,11 +349,14 @@ class LookSearch {
     const Eigen::Vector2d c = place(cell);
     rateFrom(c);
     t.resize(at(yaws_));
+    std::vector<float>& short_by = shortfall_[at(cell)];
+    short_by.resize(at(yaws_));
     for (int k = 0; k < yaws_; ++k) {
       const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
         return trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
       });
-      t[at(k)] = !ruled_out && rater_.shortfall(yawOf(k)) <= 0.0 ? 1 : 0;
+      short_by[at(k)] = ruled_out ? kRuledOut : static_cast<float>(rater_.shortfall(yawOf(k)));
+      t[at(k)] = short_by[at(k)] <= 0.0F ? 1 : 0;
     }
     ++cells_rated_;
     return t;
@@ -386,6 +430,7 @@ class LookSearch {
   int start_state_ = 0;
   std::vector<std::int8_t> clear_;                    // per cell: -1 not asked yet
   std::vector<std::vector<std::uint8_t>> trackable_;  // per cell, per yaw (empty: not rated yet)
+  std::vector<std::vector<float>> shortfall_;         // ... the rater's, kRuledOut where the guard tripped
   std::vector<CellSight> sight_;                      // per cell (empty: not cast yet)
   std::vector<int> stamp_;                            // per column: the cell whose rays reached it last
   std::vector<std::uint8_t> on_way_;                  // per column: its Tier (kAny: neither near nor on)
@@ -396,15 +441,6 @@ class LookSearch {
 };
 
 }  // namespace
-
-bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m,
-                 double beyond_rad) {
-  if ((event.wedge.apex.head<2>() - p).norm() > within_m) return false;
-  const double turn = wrapAngle(event.yaw_rad - event.good_yaw_rad);
-  const double sign = turn >= 0.0 ? 1.0 : -1.0;
-  const double along = sign * wrapAngle(yaw_rad - event.good_yaw_rad);  // in the turn's direction
-  return along >= 0.5 * std::abs(turn) && along <= std::abs(turn) + beyond_rad;
-}
 
 LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
                   const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& route,
@@ -417,6 +453,7 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
   int target = search.reached(goal.head<2>());
   out.goal = target >= 0;
   Tier tier = Tier::kWay;
+  int probe_from = -1;  // LookConfig::probe: the state reached that turns to the probed view
   if (!out.goal) {
     search.markWay(way_on);
     // With advance, a look must observe at least the robot's footprint of unknown columns: less
@@ -428,7 +465,11 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
     if (target < 0 && config.advance) {
       target = search.advance(route, config.advance_min_m, memory.looked);
       out.advance = target >= 0;
-      tier = Tier::kNear;
+      if (target < 0 && config.probe && planner::polylineLength3(way_on) <= config.near_m) {
+        target = search.probe(min_seen, memory.looked, &probe_from, &out);
+      }
+      out.probe = target >= 0 && !out.advance;
+      if (!out.probe) tier = Tier::kNear;
       if (target < 0) target = search.chooseLook(tier, min_seen, memory.looked, &out);
     }
     if (target < 0 && !out.advance) {
@@ -440,8 +481,8 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
   }
   out.cells = search.cellsRated();
   if (target < 0) return out;
-  out.cost_m = search.cost(target);
-  out.path = search.pathTo(target);
+  out.cost_m = search.cost(out.probe ? probe_from : target);
+  out.path = out.probe ? search.pathTurningTo(probe_from, target) : search.pathTo(target);
   if (!out.goal && !out.advance) out.watched = search.watched(target, tier);
   if (out.goal) {
     if (out.path.size() == 1) out.path.push_back(start);  // already in the goal's cell

@@ -55,6 +55,16 @@ struct LookConfig {
   bool advance = false;
   double advance_min_m = 0.5;
   double near_m = 2.0;
+  // trial.look_probe (with advance): where the way on is the last stretch to the goal (at most near_m
+  // long), no trackable view the search reaches observes it and it cannot advance, it turns, at a
+  // reached cell, to the view of the way on (at least the footprint of it) that the model rates least
+  // short, trackable or not, where the tracking guard has not tripped. The model counts only
+  // landmarks mapped so far, so it rates a view into space not yet mapped bare whatever stands there;
+  // the guard (trial.guard_tracking) stops the turn where the VO's inliers say it is not trackable,
+  // and that view is then ruled out (tripped_m). Farther from the goal the looks explore instead: at
+  // the start, with nothing mapped, probes are all the search finds, and their trips closed the way
+  // (detour-5001: no_path at 14 s).
+  bool probe = false;
   // trial.look_calibrate_floor: > 0, the inliers the VO tracks the current view with. The rater
   // expects fewer detections than the VO finds inliers (it counts only mapped landmarks, through
   // observed space); a view it expects to give the current view's detections times floor_inliers /
@@ -73,6 +83,7 @@ struct LookPlan {
   bool goal = false;     // the path ends at the goal instead (the search reached its cell)
   bool advance = false;  // ... on the route, short of the way on (LookConfig::advance)
   bool near = false;     // the look pose observes unknown columns near the way on (LookConfig::advance)
+  bool probe = false;    // ... of the way on, turned to whatever the model rates it (LookConfig::probe)
   // The centres of the unknown columns the look pose's view observes (the `seen`; empty where the
   // path ends at the goal or advances).
   std::vector<Eigen::Vector2d> watched;
@@ -100,13 +111,10 @@ struct LookMemory {
 // reaches whose view observes unknown cells of the way on, it takes the nearest (by the cost of
 // moves and turns) of those that observe at least half as many as the best; ties go to more seen,
 // then the first settled. Where none does, the same choice among views of any unknown cells; with
-// config.advance, first the advance and the views near the way on (LookConfig::advance).
+// config.advance, first the advance, the probe (config.probe) and the views near the way on
+// (LookConfig::advance).
 LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const planner::Pose4& start,
                   const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& route,
                   const std::vector<Eigen::Vector3d>& way_on, const LookMemory& memory, const LookConfig& config);
-
-// Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
-// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it.
-bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m, double beyond_rad);
 
 }  // namespace tgnav::harness

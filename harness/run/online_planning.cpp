@@ -232,6 +232,7 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   look.visited_clear_m = clear_m;
   look.way_clear_m = clear_m;
   look.advance = cfg_.look_advance;
+  look.probe = cfg_.look_probe;
   look.floor_inliers = cfg_.guard_inliers;
   if (cfg_.look_calibrate_floor && last_inliers_ >= cfg_.guard_inliers) look.tracked_inliers = last_inliers_;
   // The views it flies must expect trial.look_min_detections detections (150 by default, what the
@@ -250,6 +251,7 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   a->record.look_goal = found.goal;
   a->record.look_advance = found.advance;
   a->record.look_near = found.near;
+  a->record.look_probe = found.probe;
   a->record.look_floor = found.floor;
   if (found.path.size() < 2) {
     a->record.ok = false;

@@ -78,6 +78,7 @@ struct OnlinePlan {
   bool look_goal = false;
   bool look_advance = false;  // trial.look_advance: it flew along the route instead (LookPlan::advance)
   bool look_near = false;     // ... it looked near the way on (LookPlan::near)
+  bool look_probe = false;    // ... it turned to a view of the way on the model rates short (LookPlan::probe)
   double look_floor = -1.0;   // ... the detection floor its views were rated with (LookPlan::floor)
   int look_cells = 0;         // cells whose views the search rated
   int landmarks = 0;          // in the map it planned on

@@ -120,4 +120,13 @@ void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres
   tree->updateInnerOccupancy();
 }
 
+bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m,
+                 double beyond_rad) {
+  if ((event.wedge.apex.head<2>() - p).norm() > within_m) return false;
+  const double turn = std::remainder(event.yaw_rad - event.good_yaw_rad, 2.0 * M_PI);
+  const double sign = turn >= 0.0 ? 1.0 : -1.0;
+  const double along = sign * std::remainder(yaw_rad - event.good_yaw_rad, 2.0 * M_PI);  // in the turn's direction
+  return along >= 0.5 * std::abs(turn) && along <= std::abs(turn) + beyond_rad;
+}
+
 }  // namespace tgnav::harness

@@ -46,6 +46,10 @@ struct GuardEvent {
   BlindWedge wedge;  // its apex: where the camera was (estimated)
 };
 
+// Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
+// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it.
+bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m, double beyond_rad);
+
 // How many of a frame's inliers (vo::FrameResult::inlier_columns, binned across `camera`'s image)
 // stay in the image after the camera turns by turn_rad about its vertical axis (counter-clockwise,
 // as yaw, positive: the points move right), its edges moved in by edge_px (where the detector

@@ -411,6 +411,12 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_ahead_keeps_tracking = true;
   EXPECT_EQ(invalidArgument(t),
             "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
+  t = TrialConfig{};
+  t.online.look_probe = true;
+  EXPECT_EQ(invalidArgument(t),
+            "look_probe = true: needs look_advance = true (it probes where the vehicle cannot advance)");
+  t.online.look_advance = true;
+  EXPECT_EQ(invalidArgument(t), "");
   // Online, the vehicle flies on the pose it maps at.
   t = TrialConfig{};
   t.online.mode = TrialMode::kOnline;

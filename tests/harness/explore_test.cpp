@@ -155,6 +155,71 @@ TEST(LookThenFly, AdvancesAlongTheRouteWhereNoReachedViewObservesTheWayOn) {
                                                    std::pow(room.voxels.resolution(), 2))));
 }
 
+TEST(LookThenFly, ProbesTheViewOfTheWayOnRatedLeastShortWhereItCannotAdvance) {
+  Room room(3.4);
+  // The way on runs south of the observed room (y < -1.5 is unknown), at its west side: only views
+  // facing away from the wall observe it, and the model rates every such view short.
+  const Eigen::Vector3d goal(0.2, -2.2, kHeight);
+  std::vector<Eigen::Vector3d> way_on;
+  for (int i = 0; i < 4; ++i) way_on.emplace_back(0.2, -1.6 - 0.2 * i, kHeight);  // 0.6 m
+  const std::vector<Eigen::Vector3d> route{kStart.p_WB, kStart.p_WB + Eigen::Vector3d(0.3, 0.0, 0.0)};
+  LookConfig c = config();
+  c.advance = true;
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {}};
+  const LookPlan near = planLook(room.voxels, room.rater, kStart, goal, route, way_on, memory, c);
+  EXPECT_FALSE(near.way);
+  EXPECT_FALSE(near.probe);
+  c.probe = true;
+  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, route, way_on, memory, c);
+  ASSERT_TRUE(plan.probe);
+  EXPECT_TRUE(plan.way);
+  EXPECT_FALSE(plan.advance);
+  EXPECT_FALSE(plan.near);
+  ASSERT_GE(plan.path.size(), 2U);
+  const int footprint =
+      static_cast<int>(std::ceil(M_PI * c.robot_radius_m * c.robot_radius_m / std::pow(room.voxels.resolution(), 2)));
+  EXPECT_GE(plan.seen, footprint);
+  ASSERT_FALSE(plan.watched.empty());
+  for (const Eigen::Vector2d& w : plan.watched) {
+    EXPECT_TRUE(std::any_of(way_on.begin(), way_on.end(), [&](const Eigen::Vector3d& p) {
+      return (p.head<2>() - w).norm() <= c.way_clear_m + 1e-9;
+    })) << w.transpose();
+  }
+  // Every pose up to the last is flown with a trackable view in observed space; the last turns, where
+  // the one before it is, to the probed view, which the model rates short.
+  for (std::size_t i = 0; i < plan.path.size(); ++i) {
+    const planner::Pose4& p = plan.path[i];
+    EXPECT_TRUE(observedFree(room.voxels, p.p_WB)) << p.p_WB.transpose();
+    room.rater.moveTo(p.p_WB);
+    if (i + 1 < plan.path.size()) {
+      EXPECT_EQ(room.rater.shortfall(p.yaw_rad), 0.0) << i;
+    }
+  }
+  const planner::Pose4& probe = plan.path.back();
+  EXPECT_EQ(probe.p_WB, plan.path[plan.path.size() - 2].p_WB);
+  room.rater.moveTo(probe.p_WB);
+  const double short_by = room.rater.shortfall(probe.yaw_rad);
+  EXPECT_GT(short_by, 0.0);
+  std::cout << "[ figure   ] probe from (" << probe.p_WB.x() << ", " << probe.p_WB.y() << ") yaw "
+            << std::remainder(probe.yaw_rad, 2.0 * M_PI) / kDeg << " deg, short by " << short_by << ", sees "
+            << plan.seen << " columns of the way on; without the option: near " << near.near << ", seen " << near.seen
+            << "\n";
+  // A way on longer than near_m is not the last stretch: it looks near it instead.
+  LookConfig far = c;
+  far.near_m = 0.5;  // the way on is 0.6 m long
+  EXPECT_FALSE(planLook(room.voxels, room.rater, kStart, goal, route, way_on, memory, far).probe);
+  // Where the guard tripped on it, that view is ruled out: the next probe is another.
+  GuardEvent trip;
+  trip.wedge.apex = probe.p_WB;
+  trip.good_yaw_rad = plan.path[plan.path.size() - 2].yaw_rad;
+  trip.yaw_rad = probe.yaw_rad;
+  const LookPlan next =
+      planLook(room.voxels, room.rater, kStart, goal, route, way_on, LookMemory{{kStart.p_WB}, {}, {}, {trip}}, c);
+  ASSERT_TRUE(next.probe);
+  const planner::Pose4& other = next.path.back();
+  EXPECT_FALSE(trippedView(trip, other.p_WB.head<2>(), other.yaw_rad, c.tripped_m, c.half_hfov_rad));
+}
+
 TEST(LookThenFly, ColumnsGivenUpNoLongerDrawALook) {
   Room room(3.4);
   const Eigen::Vector3d goal = kNorthGoal;

@@ -285,11 +285,11 @@ TEST(OnlineTrial, LookThenFlyHoldsUntilAViewCanBeFlownAndNeverFliesWhereItsMapIs
   }
   const nlohmann::json metrics = readJson(dir / "look/metrics.json");
   EXPECT_TRUE(metrics["collision"].is_null());
-  // The goal-directed looks and the calibrated floor (not adopted; docs/results/advance): the floor
-  // is 150 until the VO has tracked a frame, then never above it.
+  // The goal-directed looks, the probe and the calibrated floor (not adopted; docs/results/advance):
+  // the floor is 150 until the VO has tracked a frame, then never above it.
   ASSERT_EQ(shell(trialCommand(args +
                                " --set trial.look_advance=true --set trial.look_give_up=2"
-                               " --set trial.look_calibrate_floor=true --out " +
+                               " --set trial.look_probe=true --set trial.look_calibrate_floor=true --out " +
                                (dir / "advance").string()))
                 .rc,
             0);
@@ -298,8 +298,9 @@ TEST(OnlineTrial, LookThenFlyHoldsUntilAViewCanBeFlownAndNeverFliesWhereItsMapIs
   EXPECT_EQ(advance[0]["look_floor"], 150.0);
   for (std::size_t i = 1; i < advance.size(); ++i) {
     std::cout << "[ figure   ] goal-directed plan at " << advance[i]["t_s"] << " s: floor " << advance[i]["look_floor"]
-              << ", advance " << advance[i]["look_advance"] << ", near " << advance[i]["look_near"] << ", sees "
-              << advance[i]["look_seen"] << "\n";
+              << ", advance " << advance[i]["look_advance"] << ", near " << advance[i]["look_near"] << ", probe "
+              << advance[i]["look_probe"] << ", sees " << advance[i]["look_seen"] << "\n";
+    EXPECT_TRUE(advance[i]["look_probe"].is_boolean());
     if (advance[i]["look_seen"].get<int>() >= 0) {
       EXPECT_LE(advance[i]["look_floor"].get<double>(), 150.0);
     }
