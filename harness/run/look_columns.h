@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -103,6 +104,30 @@ class LookColumns {
   std::vector<std::uint8_t> known_;  // observed, or within visited_clear_m of a visited place
   std::vector<std::uint8_t> seen_;   // observed, or within the robot radius of one
   std::vector<std::uint8_t> given_up_;
+};
+
+// trial.look_give_up: per unknown column, how many adopted looks were to observe it
+// (LookPlan::watched), and the columns counted often enough to give up (LookMemory::given_up).
+class LookWatch {
+ public:
+  // Counts each centre's column on the map's grid (res_m; the voxel map's origin a multiple of it).
+  void note(const std::vector<Eigen::Vector2d>& watched, double res_m) {
+    for (const Eigen::Vector2d& c : watched) {
+      const std::pair<long, long> key{std::lround(std::floor(c.x() / res_m)), std::lround(std::floor(c.y() / res_m))};
+      ++count_.try_emplace(key, c, 0).first->second.second;  // the first centre seen stays
+    }
+  }
+  // The centres of the columns counted at least `after` times (none where after <= 0).
+  std::vector<Eigen::Vector2d> givenUp(int after) const {
+    std::vector<Eigen::Vector2d> points;
+    for (const auto& [key, watch] : count_) {
+      if (after > 0 && watch.second >= after) points.push_back(watch.first);
+    }
+    return points;
+  }
+
+ private:
+  std::map<std::pair<long, long>, std::pair<Eigen::Vector2d, int>> count_;  // per column: a centre, looks
 };
 
 }  // namespace tgnav::harness

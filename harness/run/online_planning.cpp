@@ -271,22 +271,10 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
 void OnlinePlanning::noteLook(const Attempt& a) {
   if (!a.look) return;
   looked_.push_back(*a.look);
-  if (cfg_.look_give_up <= 0 || !a.map) return;
-  const double res = a.map->resolution();
-  for (const Eigen::Vector2d& c : a.watched) {
-    const std::pair<long, long> key{std::lround(std::floor(c.x() / res)), std::lround(std::floor(c.y() / res))};
-    ++watch_count_.try_emplace(key, c, 0).first->second.second;  // the first centre seen stays
-  }
+  if (cfg_.look_give_up > 0 && a.map) watch_.note(a.watched, a.map->resolution());
 }
 
-std::vector<Eigen::Vector2d> OnlinePlanning::givenUp() const {
-  std::vector<Eigen::Vector2d> points;
-  if (cfg_.look_give_up <= 0) return points;
-  for (const auto& [key, watch] : watch_count_) {
-    if (watch.second >= cfg_.look_give_up) points.push_back(watch.first);
-  }
-  return points;
-}
+std::vector<Eigen::Vector2d> OnlinePlanning::givenUp() const { return watch_.givenUp(cfg_.look_give_up); }
 
 OnlinePlanning::Attempt OnlinePlanning::planClearOf(const planner::Pose4& start, double t_s,
                                                     const std::string& trigger) {

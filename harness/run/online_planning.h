@@ -17,7 +17,6 @@
 // prior: an unseen surface gives the VO nothing) and prefers routes past what it has seen textured.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -27,6 +26,7 @@
 #include "harness/config/scenario.h"
 #include "harness/run/external_plan.h"
 #include "harness/run/incremental_map.h"
+#include "harness/run/look_columns.h"
 #include "harness/run/plan_run.h"
 #include "harness/run/view_guard.h"
 #include "planner/feature_map.h"
@@ -205,7 +205,7 @@ class OnlinePlanning {
   // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
   // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
   bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
-  // An adopted plan's look pose: not chosen again, and its columns counted (watch_count_).
+  // An adopted plan's look pose: not chosen again, and its columns counted (watch_).
   void noteLook(const Attempt& a);
   // The columns trial.look_give_up looks were to observe (their centres).
   std::vector<Eigen::Vector2d> givenUp() const;
@@ -270,9 +270,7 @@ class OnlinePlanning {
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
-  // ... per unknown column (keyed by its centre's cell on the map's resolution): its centre, and how
-  // many look poses adopted were to observe it (trial.look_give_up).
-  std::map<std::pair<long, long>, std::pair<Eigen::Vector2d, int>> watch_count_;
+  LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
   OnlineResult result_;
 };

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "harness/run/look_columns.h"
 #include "planner/feature_map.h"
 #include "tests/harness/test_util.h"
 
@@ -241,6 +242,36 @@ TEST(LookThenFly, ColumnsGivenUpNoLongerDrawALook) {
   }
   std::cout << "[ figure   ] the first look watches " << first.watched.size() << " columns (" << first.seen
             << " of the way on by its rays); with those given up the next watches " << next.watched.size() << "\n";
+}
+
+TEST(LookThenFly, TheColumnsWatchedAreGivenUpAfterTheLooksSet) {
+  Room room(3.4);
+  const LookPlan first = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(),
+                                  LookMemory{{kStart.p_WB}, {}, {}, {}}, config());
+  ASSERT_TRUE(first.way);
+  const double res = room.voxels.resolution();
+  LookWatch watch;
+  watch.note(first.watched, res);
+  EXPECT_TRUE(watch.givenUp(2).empty());
+  EXPECT_TRUE(watch.givenUp(0).empty());  // 0: never given up
+  watch.note(first.watched, res);
+  // Given up after two looks: each watched column, in its own column of the search's grid (not one
+  // off, at a column's boundary: the defect fixed in 63e55c9).
+  const std::vector<Eigen::Vector2d> given_up = watch.givenUp(2);
+  ASSERT_EQ(given_up.size(), first.watched.size());
+  const LookColumns columns(room.voxels, config(), LookMemory{{kStart.p_WB}, {}, {}, {}});
+  const auto cells = [&](const std::vector<Eigen::Vector2d>& points) {
+    std::vector<std::pair<int, int>> out;
+    for (const Eigen::Vector2d& p : points) out.push_back(columns.cellOf(p));
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(cells(given_up), cells(first.watched));
+  const LookColumns after(room.voxels, config(), LookMemory{{kStart.p_WB}, {}, given_up, {}});
+  for (const Eigen::Vector2d& c : first.watched) {
+    const auto [i, j] = after.cellOf(c);
+    EXPECT_FALSE(after.toObserve(after.index(i, j))) << c.transpose();
+  }
 }
 
 TEST(LookThenFly, TheFloorCalibratedOnTheTrackedViewLetsItMove) {
