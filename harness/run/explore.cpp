@@ -53,7 +53,6 @@ class LookSearch {
     step_ = 2.0 * M_PI / yaws_;
     const std::size_t cells = static_cast<std::size_t>(gx_) * gy_;
     clear_.assign(cells, -1);
-    trackable_.resize(cells);
     shortfall_.resize(cells);
     sight_.resize(cells);
     stamp_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), -1);
@@ -93,7 +92,7 @@ class LookSearch {
       const int k = s % yaws_;
       for (int dk : {-1, 1}) {
         const int k2 = (k + dk + yaws_) % yaws_;
-        if (trackable(cell)[at(k2)]) relax(s, cell * yaws_ + k2, c + turn_cost);
+        if (trackable(cell, k2)) relax(s, cell * yaws_ + k2, c + turn_cost);
       }
       const int ci = cell % gx_;
       const int cj = cell / gx_;
@@ -101,7 +100,7 @@ class LookSearch {
         for (int di = -1; di <= 1; ++di) {
           if ((di == 0 && dj == 0) || ci + di < 0 || cj + dj < 0 || ci + di >= gx_ || cj + dj >= gy_) continue;
           const int next = (cj + dj) * gx_ + ci + di;
-          if (!clear(next) || !trackable(next)[at(k)]) continue;
+          if (!clear(next) || !trackable(next, k)) continue;
           relax(s, next * yaws_ + k, c + config_.cell_m * std::hypot(di, dj));
         }
       }
@@ -194,16 +193,15 @@ class LookSearch {
       const int cell = s / yaws_;
       if (asked[at(cell)]) continue;
       asked[at(cell)] = 1;
-      trackable(cell);
+      const std::vector<float>& short_by = shortfalls(cell);
       const CellSight& cs = sight(cell);
       for (int k = 0; k < yaws_; ++k) {
         const int view = cell * yaws_ + k;
-        const float short_by = shortfall_[at(cell)][at(k)];
-        if (short_by >= least || view == start_state_ || repeats(view, looked)) continue;
+        if (short_by[at(k)] >= least || view == start_state_ || repeats(view, looked)) continue;
         const int seen = seenAlong(cs.way, yawOf(k));
         if (seen < min_seen) continue;
         chosen = view;
-        least = short_by;
+        least = short_by[at(k)];
         *from = s;
         out->seen = seen;
       }
@@ -342,25 +340,24 @@ class LookSearch {
     });
   }
 
-  // Per yaw, whether the view from the cell rates trackable (and the guard did not trip on it).
-  const std::vector<std::uint8_t>& trackable(int cell) {
-    std::vector<std::uint8_t>& t = trackable_[at(cell)];
-    if (!t.empty()) return t;
+  // Per yaw, how far the view from the cell falls short of trackable (ViewRater::shortfall; 0:
+  // trackable), kRuledOut where the guard tripped on it.
+  const std::vector<float>& shortfalls(int cell) {
+    std::vector<float>& short_by = shortfall_[at(cell)];
+    if (!short_by.empty()) return short_by;
     const Eigen::Vector2d c = place(cell);
     rateFrom(c);
-    t.resize(at(yaws_));
-    std::vector<float>& short_by = shortfall_[at(cell)];
     short_by.resize(at(yaws_));
     for (int k = 0; k < yaws_; ++k) {
       const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
         return trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
       });
       short_by[at(k)] = ruled_out ? kRuledOut : static_cast<float>(rater_.shortfall(yawOf(k)));
-      t[at(k)] = short_by[at(k)] <= 0.0F ? 1 : 0;
     }
     ++cells_rated_;
-    return t;
+    return short_by;
   }
+  bool trackable(int cell, int k) { return shortfalls(cell)[at(k)] <= 0.0F; }
 
   // What the cell's views observe: rays kRayStepRad apart to config.observe_range_m, through
   // unknown columns (optimistic), stopping at occupied ones.
@@ -428,15 +425,14 @@ class LookSearch {
   double step_ = 2.0 * M_PI;
   int start_cell_ = 0;
   int start_state_ = 0;
-  std::vector<std::int8_t> clear_;                    // per cell: -1 not asked yet
-  std::vector<std::vector<std::uint8_t>> trackable_;  // per cell, per yaw (empty: not rated yet)
-  std::vector<std::vector<float>> shortfall_;         // ... the rater's, kRuledOut where the guard tripped
-  std::vector<CellSight> sight_;                      // per cell (empty: not cast yet)
-  std::vector<int> stamp_;                            // per column: the cell whose rays reached it last
-  std::vector<std::uint8_t> on_way_;                  // per column: its Tier (kAny: neither near nor on)
-  std::vector<double> cost_;                          // per state
-  std::vector<int> prev_;                             // per state
-  std::vector<int> settled_;                          // in order of cost
+  std::vector<std::int8_t> clear_;             // per cell: -1 not asked yet
+  std::vector<std::vector<float>> shortfall_;  // per cell, per yaw: shortfalls() (empty: not rated yet)
+  std::vector<CellSight> sight_;               // per cell (empty: not cast yet)
+  std::vector<int> stamp_;                     // per column: the cell whose rays reached it last
+  std::vector<std::uint8_t> on_way_;           // per column: its Tier (kAny: neither near nor on)
+  std::vector<double> cost_;                   // per state
+  std::vector<int> prev_;                      // per state
+  std::vector<int> settled_;                   // in order of cost
   int cells_rated_ = 0;
 };
 
