@@ -442,7 +442,12 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
                   const Eigen::Vector3d& goal, const std::vector<Eigen::Vector3d>& route,
                   const std::vector<Eigen::Vector3d>& way_on, const LookMemory& memory, const LookConfig& config) {
   LookPlan out;
-  LookSearch search(voxels, rater, start, memory, config);
+  // The goal counts as a visited place: the mission gives it free, as it gives the start (the
+  // planners' snapshot marks both free). Else a goal within known_m of space never observed, a
+  // strip the views toward it leave, is a cell the search never enters (detour-1014, -5007).
+  LookMemory free_goal = memory;
+  free_goal.visited.push_back(goal);
+  LookSearch search(voxels, rater, start, free_goal, config);
   out.floor = search.calibrateFloor();
   search.run();
   out.states = search.states();

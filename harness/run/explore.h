@@ -105,7 +105,8 @@ struct LookMemory {
 
 // The search on `voxels` (the plan's voxel map; its `observed` decides what is unknown), views
 // rated by `rater` (moved about by the search) with only the landmarks whose line of sight crosses
-// observed columns. Where it reaches the cell of `goal`, the path ends there (at the goal itself).
+// observed columns. Where it reaches the cell of `goal`, the path ends there (at the goal itself);
+// the goal counts as a visited place (LookMemory::visited), free as the start is.
 // Else: `route` is the planner's route from the start up to where it first runs into unknown
 // space, `way_on` the rest of it; `memory`, what the flight so far tells it. Among the states it
 // reaches whose view observes unknown cells of the way on, it takes the nearest (by the cost of

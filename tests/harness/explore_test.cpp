@@ -69,6 +69,30 @@ TEST(LookThenFly, FliesToAGoalInObservedSpaceWithEveryViewTrackable) {
             << plan.states << " states\n";
 }
 
+TEST(LookThenFly, TheGoalCountsAsFreeThoughSpaceBeyondItWasNeverObserved) {
+  Room room(3.4);
+  // Just inside the observed room (y >= 1 is unknown): its cell lies within the robot radius of
+  // space never observed, so only the goal's own disc, free as the mission gives it, lets the
+  // search enter it.
+  const Eigen::Vector3d goal(2.5, 0.85, kHeight);
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {}};
+  const LookColumns without(room.voxels, config(), memory);
+  ASSERT_FALSE(without.clear(goal.head<2>(), config().robot_radius_m, config().known_m));
+  const LookPlan plan = planLook(room.voxels, room.rater, kStart, goal, {}, {}, memory, config());
+  ASSERT_TRUE(plan.goal);
+  ASSERT_GE(plan.path.size(), 2U);
+  EXPECT_EQ(plan.path.back().p_WB, goal);
+  for (const planner::Pose4& p : plan.path) {
+    EXPECT_TRUE(observedFree(room.voxels, p.p_WB)) << p.p_WB.transpose();
+    room.rater.moveTo(p.p_WB);
+    EXPECT_EQ(room.rater.shortfall(p.yaw_rad), 0.0) << p.p_WB.transpose() << " yaw " << p.yaw_rad;
+  }
+  // Farther into the unknown than the goal's disc reaches, it does not.
+  const LookPlan beyond =
+      planLook(room.voxels, room.rater, kStart, Eigen::Vector3d(2.5, 1.9, kHeight), {}, {}, memory, config());
+  EXPECT_FALSE(beyond.goal);
+}
+
 TEST(LookThenFly, LooksAtTheUnknownWayOnFromAViewThatKeepsTheWallInSight) {
   Room room(3.4);
   // The goal lies north, beyond the observed room (y >= 1 is unknown): the way on runs there.
@@ -158,11 +182,13 @@ TEST(LookThenFly, AdvancesAlongTheRouteWhereNoReachedViewObservesTheWayOn) {
 
 TEST(LookThenFly, ProbesTheViewOfTheWayOnRatedLeastShortWhereItCannotAdvance) {
   Room room(3.4);
-  // The way on runs south of the observed room (y < -1.5 is unknown), at its west side: only views
-  // facing away from the wall observe it, and the model rates every such view short.
-  const Eigen::Vector3d goal(0.2, -2.2, kHeight);
+  // The way on runs north of the observed room (y >= 1 is unknown), at its west side: only views
+  // facing away from the wall observe it, and the model rates every such view short. (It is long
+  // enough that what it leaves unknown beyond the goal's disc, free as the mission gives it, is more
+  // than a footprint.)
+  const Eigen::Vector3d goal(0.2, 2.7, kHeight);
   std::vector<Eigen::Vector3d> way_on;
-  for (int i = 0; i < 4; ++i) way_on.emplace_back(0.2, -1.6 - 0.2 * i, kHeight);  // 0.6 m
+  for (int i = 0; i < 9; ++i) way_on.emplace_back(0.2, 1.1 + 0.2 * i, kHeight);  // 1.6 m
   const std::vector<Eigen::Vector3d> route{kStart.p_WB, kStart.p_WB + Eigen::Vector3d(0.3, 0.0, 0.0)};
   LookConfig c = config();
   c.advance = true;
@@ -207,7 +233,7 @@ TEST(LookThenFly, ProbesTheViewOfTheWayOnRatedLeastShortWhereItCannotAdvance) {
             << "\n";
   // A way on longer than near_m is not the last stretch: it looks near it instead.
   LookConfig far = c;
-  far.near_m = 0.5;  // the way on is 0.6 m long
+  far.near_m = 1.5;  // the way on is 1.6 m long
   EXPECT_FALSE(planLook(room.voxels, room.rater, kStart, goal, route, way_on, memory, far).probe);
   // Where the guard tripped on it, that view is ruled out: the next probe is another.
   GuardEvent trip;
