@@ -6,6 +6,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include "harness/base/errors.h"
@@ -806,7 +807,15 @@ using VisitedConfigs =
                      planner::SegmentConfig, planner::PoseGraphConfig, planner::SelectionConfig,
                      planner::PerceptionPlannerConfig, planner::RrtStarConfig, planner::TrajectoryConfig, CameraConfig,
                      FlightConfig, ImuConfig, TrialConfig, PlannerSettings, SurveyPlan, SceneConfig>;
-TYPED_TEST_SUITE(ConfigVisit, VisitedConfigs);
+// Each type's tests named by its place in the list, as gtest's default does; named here so that the
+// macro's variadic argument is given (clang: -Wgnu-zero-variadic-macro-arguments).
+struct VisitedName {
+  template <typename T>
+  static std::string GetName(int i) {
+    return std::to_string(i);
+  }
+};
+TYPED_TEST_SUITE(ConfigVisit, VisitedConfigs, VisitedName);
 
 // Written with every value changed, read back over the defaults, written again: the same text,
 // and every key's value differs from its default (so every key was read into its field).

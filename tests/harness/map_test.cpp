@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <iostream>
 
 #include "harness/config/scenario.h"
@@ -162,7 +163,9 @@ TEST_F(SmokeMapTest, TexturedCratesCarryLandmarksThePlainPillarNone) {
   // Landmarks within 0.15 m of the pillar (plain) vs. of crate_e1 (textured), which have
   // comparable exposed areas.
   auto near_geom = [&](const char* name) {
-    const int g = mj_name2id(model_, mjOBJ_GEOM, name);
+    const std::ptrdiff_t g = mj_name2id(model_, mjOBJ_GEOM, name);
+    EXPECT_GE(g, 0) << name;
+    if (g < 0) return -1;
     const Eigen::Vector3d c(data_->geom_xpos + 3 * g);
     const Eigen::Vector3d h(model_->geom_size + 3 * g);
     int n = 0;
