@@ -100,6 +100,10 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_probe = true: needs look_advance = true (it probes where the vehicle cannot advance)");
   }
+  if (look_fallback && !look_then_fly) {
+    throw std::invalid_argument(
+        "look_fallback = true: needs look_then_fly = true (it is what a plan does when no look is left)");
+  }
   require(look_give_up >= 0 && look_give_up <= 1000, "look_give_up", look_give_up, "must be in [0, 1000]");
   require(std::isfinite(look_min_detections) && look_min_detections >= 0.0 && look_min_detections <= 10000.0,
           "look_min_detections", look_min_detections, "must be in [0, 10000]");

@@ -169,6 +169,12 @@ struct OnlineConfig {
   // Most explorer flights that failed had a route whose first unobserved point lay within 2 m of the
   // goal; measured, not adopted (premise 0/16: docs/results/advance).
   bool look_probe = false;
+  // With look_then_fly: where the search finds no trackable view that observes any unknown space
+  // (the explorer has run out of looks), the plan flies the planner's route as an online trial
+  // without look_then_fly does (stop_before_unknown, the look-ahead rule, the tracking guard) instead
+  // of holding. false: the vehicle holds, and kMaxFailedPlans such plans in a row end the trial in
+  // no_path (7 of the 16 premise flights at 7452bb9: docs/results/advance).
+  bool look_fallback = false;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the
   // current view over its inliers, where that is lower (LookConfig::tracked_inliers): the model
@@ -241,6 +247,7 @@ struct OnlineConfig {
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);
+    a("look_fallback", look_fallback);
     a("look_calibrate_floor", look_calibrate_floor);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);

@@ -246,6 +246,11 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   a->record.look_cells = found.cells;
   // A route all observed that the search cannot fly with trackable views: flown as planned.
   if (all_observed && !found.goal) return false;
+  // trial.look_fallback: no look left, the route flown as planned (stop_before_unknown, look-ahead).
+  if (found.path.size() < 2 && cfg_.look_fallback) {
+    a->record.look_fallback = true;
+    return false;
+  }
   a->record.look_seen = found.seen;
   a->record.look_way = found.way;
   a->record.look_goal = found.goal;

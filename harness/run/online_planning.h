@@ -76,13 +76,14 @@ struct OnlinePlan {
   int look_seen = -1;
   bool look_way = false;
   bool look_goal = false;
-  bool look_advance = false;  // trial.look_advance: it flew along the route instead (LookPlan::advance)
-  bool look_near = false;     // ... it looked near the way on (LookPlan::near)
-  bool look_probe = false;    // ... it turned to a view of the way on the model rates short (LookPlan::probe)
-  double look_floor = -1.0;   // ... the detection floor its views were rated with (LookPlan::floor)
-  int look_cells = 0;         // cells whose views the search rated
-  int landmarks = 0;          // in the map it planned on
-  int prior_landmarks = 0;    // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
+  bool look_advance = false;   // trial.look_advance: it flew along the route instead (LookPlan::advance)
+  bool look_near = false;      // ... it looked near the way on (LookPlan::near)
+  bool look_probe = false;     // ... it turned to a view of the way on the model rates short (LookPlan::probe)
+  bool look_fallback = false;  // trial.look_fallback: no look was left, and the route was flown as planned
+  double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
+  int look_cells = 0;          // cells whose views the search rated
+  int landmarks = 0;           // in the map it planned on
+  int prior_landmarks = 0;     // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
   // trial.unseen_prior route_mean: the class the plan on the map with the mean prior chose, which
   // this plan then flies (-1: none, or not asked)
   int rated_class = -1;

@@ -418,6 +418,12 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
             "look_probe = true: needs look_advance = true (it probes where the vehicle cannot advance)");
   t.online.look_advance = true;
   EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
+  t.online.look_fallback = true;
+  EXPECT_EQ(invalidArgument(t),
+            "look_fallback = true: needs look_then_fly = true (it is what a plan does when no look is left)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
   // Online, the vehicle flies on the pose it maps at.
   t = TrialConfig{};
   t.online.mode = TrialMode::kOnline;
