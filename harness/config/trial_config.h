@@ -169,11 +169,12 @@ struct OnlineConfig {
   // Most explorer flights that failed had a route whose first unobserved point lay within 2 m of the
   // goal; measured, not adopted (premise 0/16: docs/results/advance).
   bool look_probe = false;
-  // With look_then_fly: where the search finds no trackable view that observes any unknown space
-  // (the explorer has run out of looks), the plan flies the planner's route as an online trial
-  // without look_then_fly does (stop_before_unknown, the look-ahead rule, the tracking guard) instead
-  // of holding. false: the vehicle holds, and kMaxFailedPlans such plans in a row end the trial in
-  // no_path (7 of the 16 premise flights at 7452bb9: docs/results/advance).
+  // With look_then_fly: where the search finds no trackable view that observes any unknown space and
+  // that failed plan would end the trial (the third in a row, holding: no_path; 7 of the 16 premise
+  // flights at 7452bb9, docs/results/advance), the plan flies the planner's route instead, as an
+  // online trial without look_then_fly does (stop_before_unknown, the look-ahead rule, the tracking
+  // guard). Not before: at the start, with nothing mapped, flying the route lost the VO at once where
+  // holding and looking went on to the goal (development scene detour-5004).
   bool look_fallback = false;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the

@@ -246,8 +246,10 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   a->record.look_cells = found.cells;
   // A route all observed that the search cannot fly with trackable views: flown as planned.
   if (all_observed && !found.goal) return false;
-  // trial.look_fallback: no look left, the route flown as planned (stop_before_unknown, look-ahead).
-  if (found.path.size() < 2 && cfg_.look_fallback) {
+  // trial.look_fallback: no look left where this failure would end the trial (no_path), the route
+  // flown as planned (stop_before_unknown, look-ahead). Earlier, the vehicle holds and looks: at the
+  // start, with nothing mapped yet, flying the route lost the VO at once (detour-5001, -5004).
+  if (found.path.size() < 2 && cfg_.look_fallback && last_chance_) {
     a->record.look_fallback = true;
     return false;
   }

@@ -80,6 +80,7 @@ struct OnlinePlan {
   bool look_near = false;      // ... it looked near the way on (LookPlan::near)
   bool look_probe = false;     // ... it turned to a view of the way on the model rates short (LookPlan::probe)
   bool look_fallback = false;  // trial.look_fallback: no look was left, and the route was flown as planned
+                               // (where this failure would have ended the trial)
   double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
   int look_cells = 0;          // cells whose views the search rated
   int landmarks = 0;           // in the map it planned on
@@ -269,6 +270,7 @@ class OnlinePlanning {
   bool blind_view_ = false;               // ... it tripped: a plan is due
   bool stops_short_ = false;              // the trajectory flown stops short of unknown space
   int failed_in_a_row_ = 0;               // plans without a route since the last one with
+  bool last_chance_ = false;              // one more failed plan ends the trial (trial.look_fallback)
   std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
   std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
   LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
