@@ -160,7 +160,9 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   }
   const double tau_now = tau(t_s, trajectory_start_s);
   const bool spent = tau_now >= current_->endTime() - cfg_.plan_latency_s;
-  last_chance_ = failed_in_a_row_ + 1 >= kMaxFailedPlans && (spent || holding_);
+  // Failed plans this many in a row end the trial (no_path); one more is the last chance.
+  const auto ends_trial = [&](int failed) { return failed >= kMaxFailedPlans && (spent || holding_); };
+  last_chance_ = ends_trial(failed_in_a_row_ + 1);
   Attempt a = planClearOf(start, t_s, takeTrigger());
   next_replan_s_ = t_s + cfg_.replan_period_s;
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
@@ -197,7 +199,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   }
   result_.plans.push_back(a.record);
   ++failed_in_a_row_;
-  if (failed_in_a_row_ >= kMaxFailedPlans && (spent || holding_)) {
+  if (ends_trial(failed_in_a_row_)) {
     std::ostringstream why;
     why << failed_in_a_row_ << " plans in a row found no route (last: " << a.record.detail << ")";
     return why.str();
