@@ -104,6 +104,11 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_fallback = true: needs look_then_fly = true (it is what a plan does when no look is left)");
   }
+  require(std::isfinite(look_stall_s) && look_stall_s >= 0.0 && look_stall_s <= 3600.0, "look_stall_s", look_stall_s,
+          "must be in [0, 3600]");
+  if (look_stall_s > 0.0 && !look_then_fly) {
+    throw std::invalid_argument("look_stall_s > 0: needs look_then_fly = true (it is when the looks have stalled)");
+  }
   require(look_give_up >= 0 && look_give_up <= 1000, "look_give_up", look_give_up, "must be in [0, 1000]");
   require(std::isfinite(look_min_detections) && look_min_detections >= 0.0 && look_min_detections <= 10000.0,
           "look_min_detections", look_min_detections, "must be in [0, 10000]");

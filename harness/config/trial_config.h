@@ -176,6 +176,14 @@ struct OnlineConfig {
   // guard). Not before: at the start, with nothing mapped, flying the route lost the VO at once where
   // holding and looking went on to the goal (development scene detour-5004).
   bool look_fallback = false;
+  // With look_then_fly, > 0: where no plan for this long (simulated seconds) has found a route to the
+  // goal at least 0.5 m shorter than the shortest before it (RouteProgress), the looks have stalled,
+  // and the plan flies the planner's route instead, as look_fallback does. On development scene
+  // detour-5002 the vehicle shuttled 100 s between an advance and a look near the way on, 2 m
+  // apart, the way on never observed. 0: never. 60 s (a fifth of max_flight_s) was chosen, not fitted.
+  // Measured, not adopted: development 3/8 against 4/8 without it, two VO losses where the guard's
+  // trips then left only the blind route (docs/results/advance).
+  double look_stall_s = 0.0;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the
   // current view over its inliers, where that is lower (LookConfig::tracked_inliers): the model
@@ -249,6 +257,7 @@ struct OnlineConfig {
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);
     a("look_fallback", look_fallback);
+    a("look_stall_s", look_stall_s);
     a("look_calibrate_floor", look_calibrate_floor);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);

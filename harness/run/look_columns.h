@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -128,6 +129,28 @@ class LookWatch {
 
  private:
   std::map<std::pair<long, long>, std::pair<Eigen::Vector2d, int>> count_;  // per column: a centre, looks
+};
+
+// trial.look_stall_s: whether the looks still bring the vehicle closer to the goal. A plan makes
+// progress where its route to the goal (from where it starts) is at least margin_m shorter than the
+// shortest so far; the looks have stalled when none has for a while.
+class RouteProgress {
+ public:
+  explicit RouteProgress(double margin_m) : margin_m_(margin_m) {}
+  // Notes a plan's route length at t_s; returns the time since the last plan that made progress (0
+  // at the first, and at progress).
+  double note(double t_s, double route_m) {
+    if (!since_s_ || route_m < best_m_ - margin_m_) {
+      best_m_ = route_m;
+      since_s_ = t_s;
+    }
+    return t_s - *since_s_;
+  }
+
+ private:
+  double margin_m_;
+  double best_m_ = 0.0;            // the route at the last progress
+  std::optional<double> since_s_;  // ... and when (none: no plan yet)
 };
 
 }  // namespace tgnav::harness

@@ -221,6 +221,16 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   for (std::size_t i = 0; i < a->run.plan.path.size(); ++i) {
     (i < known.size() ? route : way_on).push_back(a->run.plan.path[i].p_WB);
   }
+  // trial.look_stall_s: the looks have stalled, the route flown as planned (as look_fallback does).
+  double route_m = 0.0;
+  for (std::size_t i = 1; i < a->run.plan.path.size(); ++i) {
+    route_m += (a->run.plan.path[i].p_WB - a->run.plan.path[i - 1].p_WB).norm();
+  }
+  const double stalled_s = progress_.note(a->record.t_s, route_m);
+  if (!all_observed && cfg_.look_stall_s > 0.0 && stalled_s >= cfg_.look_stall_s) {
+    a->record.look_stall = true;
+    return false;
+  }
   LookConfig look;
   look.robot_radius_m = perception.robot_radius_m;
   look.known_m = perception.robot_radius_m;  // the body never overlaps unknown space

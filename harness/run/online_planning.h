@@ -81,6 +81,7 @@ struct OnlinePlan {
   bool look_probe = false;     // ... it turned to a view of the way on the model rates short (LookPlan::probe)
   bool look_fallback = false;  // trial.look_fallback: no look was left, and the route was flown as planned
                                // (where this failure would have ended the trial)
+  bool look_stall = false;     // trial.look_stall_s: the looks had stalled, and the route was flown as planned
   double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
   int look_cells = 0;          // cells whose views the search rated
   int landmarks = 0;           // in the map it planned on
@@ -247,6 +248,10 @@ class OnlinePlanning {
                                         const planner::VoxelMap& voxels) const;
   double tau(double t_s, double trajectory_start_s) const { return tau0_ + (t_s - trajectory_start_s); }
 
+  // trial.look_stall_s: a route to the goal this much shorter than the shortest before it is progress
+  // (LookConfig::advance_min_m, the least advance).
+  static constexpr double kStallProgressM = 0.5;
+
   const Scenario& scenario_;
   const OnlineConfig& cfg_;
   planner::PlannerKind planner_;
@@ -261,18 +266,19 @@ class OnlinePlanning {
   double pending_until_s_ = -1.0;  // a plan takes effect then; none is asked before
   double last_change_s_ = -1e9;    // when the last plan that changed the route was asked
   bool blocked_ = false;
-  bool goal_seen_ = false;                // the goal's voxel has been observed
-  bool goal_event_ = false;               // ... by the last keyframe: a plan is due
-  bool holding_ = false;                  // flying a hold: no route, or the guard tripped
-  bool flying_ = false;                   // startFlight has been called
-  std::optional<ViewGuard> guard_;        // trial.guard_tracking, built-in planners
-  std::vector<BlindWedge> wedges_;        // ... where it tripped: unknown space there is planned occupied
-  bool blind_view_ = false;               // ... it tripped: a plan is due
-  bool stops_short_ = false;              // the trajectory flown stops short of unknown space
-  int failed_in_a_row_ = 0;               // plans without a route since the last one with
-  bool last_chance_ = false;              // one more failed plan ends the trial (trial.look_fallback)
-  std::vector<Eigen::Vector3d> visited_;  // where plans started: free, seen or not
-  std::vector<planner::Pose4> looked_;    // trial.look_then_fly: the look poses flown to
+  bool goal_seen_ = false;                   // the goal's voxel has been observed
+  bool goal_event_ = false;                  // ... by the last keyframe: a plan is due
+  bool holding_ = false;                     // flying a hold: no route, or the guard tripped
+  bool flying_ = false;                      // startFlight has been called
+  std::optional<ViewGuard> guard_;           // trial.guard_tracking, built-in planners
+  std::vector<BlindWedge> wedges_;           // ... where it tripped: unknown space there is planned occupied
+  bool blind_view_ = false;                  // ... it tripped: a plan is due
+  bool stops_short_ = false;                 // the trajectory flown stops short of unknown space
+  int failed_in_a_row_ = 0;                  // plans without a route since the last one with
+  bool last_chance_ = false;                 // one more failed plan ends the trial (trial.look_fallback)
+  RouteProgress progress_{kStallProgressM};  // trial.look_stall_s: the looks' progress to the goal
+  std::vector<Eigen::Vector3d> visited_;     // where plans started: free, seen or not
+  std::vector<planner::Pose4> looked_;       // trial.look_then_fly: the look poses flown to
   LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
   OnlineResult result_;

@@ -424,6 +424,13 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
             "look_fallback = true: needs look_then_fly = true (it is what a plan does when no look is left)");
   t.online.look_then_fly = true;
   EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
+  t.online.look_stall_s = 60.0;
+  EXPECT_EQ(invalidArgument(t), "look_stall_s > 0: needs look_then_fly = true (it is when the looks have stalled)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_stall_s = -1.0;
+  EXPECT_EQ(invalidArgument(t), "look_stall_s = -1: must be in [0, 3600]");
   // Online, the vehicle flies on the pose it maps at.
   t = TrialConfig{};
   t.online.mode = TrialMode::kOnline;

@@ -396,5 +396,16 @@ TEST(LookThenFly, ViewsTheGuardTrippedOnAreRuledOutNearWhereItTripped) {
   }
 }
 
+TEST(LookThenFly, TheLooksStallWhereNoRouteHasBeenHalfAMetreShorterForAWhile) {
+  RouteProgress progress(0.5);
+  EXPECT_EQ(progress.note(4.0, 12.0), 0.0);    // the first plan: progress from here
+  EXPECT_EQ(progress.note(6.0, 11.6), 2.0);    // 0.4 m shorter: not yet
+  EXPECT_EQ(progress.note(8.0, 11.5), 4.0);    // 0.5 m: not more than the margin
+  EXPECT_EQ(progress.note(10.0, 11.4), 0.0);   // 0.6 m shorter than 12, step by step: progress
+  EXPECT_EQ(progress.note(12.0, 14.0), 2.0);   // a longer route (a wedge blocked the way) is none
+  EXPECT_EQ(progress.note(70.0, 11.0), 60.0);  // 0.4 m shorter than 11.4: stalled for 60 s
+  EXPECT_EQ(progress.note(72.0, 10.8), 0.0);
+}
+
 }  // namespace
 }  // namespace tgnav::harness

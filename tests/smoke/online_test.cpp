@@ -339,6 +339,31 @@ TEST(OnlineTrial, LookFallbackFliesTheRouteWhereTheLastFailedLookWouldEndTheTria
   EXPECT_EQ(fallback[2]["look_seen"], -1);  // flown as planned
 }
 
+TEST(OnlineTrial, LookStallFliesTheRouteWhereNoPlanHasComeCloserForAWhile) {
+  // With a detection floor no view meets, the look search never finds a look and the vehicle holds:
+  // no plan's route gets shorter. With trial.look_stall_s 3, the first plan 3 s after the first
+  // flies the route instead, as without look_then_fly (the same trial without it: the fallback test).
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall +
+                           " --set trial.max_flight_s=10 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=10000 --set trial.look_stall_s=3";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "stall").string())).rc, 0);
+  EXPECT_NE(readJson(dir / "stall/metrics.json")["status"], "no_path");
+  const nlohmann::json plans = readJson(dir / "stall/online.json")["plans"];
+  ASSERT_GE(plans.size(), 3U);
+  const double first_s = plans[0]["t_s"].get<double>();
+  bool stalled = false;
+  for (std::size_t i = 0; i < plans.size() && !stalled; ++i) {
+    std::cout << "[ figure   ] plan at " << plans[i]["t_s"] << " s: ok " << plans[i]["ok"] << ", stall "
+              << plans[i]["look_stall"] << "\n";
+    stalled = plans[i]["t_s"].get<double>() - first_s >= 3.0;
+    EXPECT_EQ(plans[i]["look_stall"].get<bool>(), stalled) << i;
+    EXPECT_EQ(plans[i]["ok"].get<bool>(), stalled) << i;     // holds until then
+    if (stalled) EXPECT_EQ(plans[i]["look_seen"], -1) << i;  // flown as planned
+  }
+  EXPECT_TRUE(stalled);
+}
+
 TEST(OnlineTrial, AnExternalPlannerIsAskedAgainByTheSameProcess) {
   const auto dir = test::tempDir();
   // The example A* planner behind a guard that makes a second start of the command fail.
