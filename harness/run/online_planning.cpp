@@ -277,6 +277,9 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
         "observed space observes any";
     return true;
   }
+  const planner::Pose4& end = found.path.back();
+  a->record.look_pose = {end.p_WB.x(), end.p_WB.y(), end.p_WB.z(), end.yaw_rad};
+  a->record.look_watched = found.watched;
   a->run.plan.path = found.path;
   if (!smoothInto(from_here, "look_then_fly: ", a)) return true;
   a->stops_short = !found.goal;
@@ -371,6 +374,7 @@ control::SetpointTrajectory OnlinePlanning::firstPlan(PlanRun* run) {
   if (a.trajectory && !cfg_.hold_first_plan) {
     a.record.adopted = true;
     stops_short_ = a.stops_short;
+    looking_ = a.look.has_value();
     noteLook(a);
     current_ = std::make_unique<control::SetpointTrajectory>(
         limitYawRate(*a.trajectory, a.trajectory->startTime(), scenario_.planner.trajectory.max_yaw_rate_rad_s));

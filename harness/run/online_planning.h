@@ -83,9 +83,13 @@ struct OnlinePlan {
                                // (where this failure would have ended the trial)
   bool look_stall = false;     // trial.look_stall_s: the looks had stalled, and the route was flown as planned
   double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
-  int look_cells = 0;          // cells whose views the search rated
-  int landmarks = 0;           // in the map it planned on
-  int prior_landmarks = 0;     // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
+  // ... where its path ends (x, y, z, yaw: the look pose, or the advance's; empty: none) and the
+  // unknown columns that view is to observe (LookPlan::watched, their centres)
+  std::vector<double> look_pose;
+  std::vector<Eigen::Vector2d> look_watched;
+  int look_cells = 0;       // cells whose views the search rated
+  int landmarks = 0;        // in the map it planned on
+  int prior_landmarks = 0;  // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
   // trial.unseen_prior route_mean: the class the plan on the map with the mean prior chose, which
   // this plan then flies (-1: none, or not asked)
   int rated_class = -1;
@@ -274,6 +278,7 @@ class OnlinePlanning {
   std::vector<BlindWedge> wedges_;           // ... where it tripped: unknown space there is planned occupied
   bool blind_view_ = false;                  // ... it tripped: a plan is due
   bool stops_short_ = false;                 // the trajectory flown stops short of unknown space
+  bool looking_ = false;                     // ... at a look pose (trial.look_then_fly): flown to its end
   int failed_in_a_row_ = 0;                  // plans without a route since the last one with
   bool last_chance_ = false;                 // one more failed plan ends the trial (trial.look_fallback)
   RouteProgress progress_{kStallProgressM};  // trial.look_stall_s: the looks' progress to the goal

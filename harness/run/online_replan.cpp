@@ -114,6 +114,7 @@ void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo:
   switchTo(holdTrajectory(hold, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_now, kGuardBlendS);
   holding_ = true;
   stops_short_ = false;
+  looking_ = false;
   blind_view_ = true;
   pending_until_s_ = t_s;
 }
@@ -127,6 +128,7 @@ std::string OnlinePlanning::takeTrigger() {
 void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool before_start) {
   a->record.adopted = true;
   stops_short_ = a->stops_short;
+  looking_ = a->look.has_value();
   noteLook(*a);
   last_change_s_ = a->record.t_s;
   switchTo(*a->trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
@@ -168,18 +170,24 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
   // to this one.
   const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
+  // trial.look_then_fly: a look is flown to its end, where its view is, and a plan asked before then
+  // is not flown (its map lacks that view) unless the path ahead is blocked. Before, the commit
+  // window ran out as the vehicle arrived and the next plan cut the turn to the view: on development
+  // scene detour-5006, 24 of 28 looks never held theirs.
+  const bool looking = looking_ && !before_start && tau_now < current_->endTime();
   const bool in_flight = a.trajectory && !before_start;  // its paths are compared with the route ahead
   const std::vector<Eigen::Vector3d> ahead = in_flight ? positionsAhead(tau_switch) : std::vector<Eigen::Vector3d>{};
   if (in_flight) rateRouteBlindness(ahead, &a);
   // A plan that rates the current route blind for longer than its choice leaves it at once.
   const bool leave_blind = cfg_.leave_blind_route && leavesBlindRoute(a.record, blindTolerance());
-  const bool must_switch = holding_ || stopping || a.record.trigger == "blocked" || leave_blind;
+  const bool must_switch = holding_ || (stopping && !looking) || a.record.trigger == "blocked" || leave_blind;
   // (A plan exactly commit_s after the last change is not committed, whatever the rounding.)
-  const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9;
+  const bool committed = t_s < last_change_s_ + cfg_.commit_s - 1e-9 || looking;
   // Whether the plan follows the current route: asked only where it decides something.
   // Renewing the views is the built-in planners' (as the look-ahead): an external planner's yaw is its own.
   const bool renew = cfg_.renew_views && !external_;
-  const bool same = in_flight && !must_switch && (!committed || renew) && followsRoute(a.run.plan.path, ahead);
+  const bool same =
+      in_flight && !must_switch && !looking && (!committed || renew) && followsRoute(a.run.plan.path, ahead);
   const bool keep = cfg_.keep_route && in_flight && !worthLeavingRoute(a.record, blindTolerance(), cfg_.route_margin);
   if (a.trajectory && !must_switch && (committed || same || keep)) {
     failed_in_a_row_ = 0;
@@ -209,6 +217,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
     switchTo(holdTrajectory(start, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_switch,
              before_start ? 0.0 : cfg_.blend_s);
     holding_ = true;
+    looking_ = false;
     pending_until_s_ = t_eff;
   }
   return std::string();
