@@ -231,6 +231,12 @@ class OnlinePlanning {
   std::vector<Eigen::Vector3d> positionsAhead(double tau_from) const;
   // a.record's chosen_blind_m and route_blind_m, the route being `ahead` (positionsAhead).
   static void rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a);
+  // trial.look_then_fly: the current trajectory is a look (or an advance) not yet at its end at
+  // tau_now. It is flown to its end, where its view is, and a plan asked before then is not flown (its
+  // map lacks that view) unless the path ahead is blocked or the guard trips. Before, the commit
+  // window ran out as the vehicle arrived and the next plan cut the turn to the view: on development
+  // scene detour-5006, 24 of 28 looks never held theirs.
+  bool lookInFlight(double tau_now) const { return looking_ && tau_now < current_->endTime(); }
   // Blind lengths this close count as equal (planner.selection.blind_tolerance_m).
   double holdRate() const { return scenario_.planner.trajectory.sample_rate_hz; }
   double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }

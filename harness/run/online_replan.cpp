@@ -170,11 +170,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
   // A trajectory that stops short of unknown space and ends before the next plan is asked gives way
   // to this one.
   const bool stopping = stops_short_ && !before_start && tau_switch + cfg_.replan_period_s >= current_->endTime();
-  // trial.look_then_fly: a look is flown to its end, where its view is, and a plan asked before then
-  // is not flown (its map lacks that view) unless the path ahead is blocked. Before, the commit
-  // window ran out as the vehicle arrived and the next plan cut the turn to the view: on development
-  // scene detour-5006, 24 of 28 looks never held theirs.
-  const bool looking = looking_ && !before_start && tau_now < current_->endTime();
+  const bool looking = !before_start && lookInFlight(tau_now);
   const bool in_flight = a.trajectory && !before_start;  // its paths are compared with the route ahead
   const std::vector<Eigen::Vector3d> ahead = in_flight ? positionsAhead(tau_switch) : std::vector<Eigen::Vector3d>{};
   if (in_flight) rateRouteBlindness(ahead, &a);
