@@ -141,7 +141,8 @@ struct OnlineConfig {
   // unknown space, the vehicle flies instead, through observed free space and with every view rated
   // trackable on the map so far (and expecting at least look_min_detections detections), to the place and
   // yaw whose trackable view observes most of the unknown way on, and stops there; the next plan goes
-  // on from what it saw. Where that search reaches the goal, its way there is flown. agnostic ignores
+  // on from what it saw (a look is flown to its end: OnlinePlanning::lookInFlight). Where that search
+  // reaches the goal, its way there is flown. agnostic ignores
   // it (it has no perception model). Measured and left off: it kept the VO for minutes, but as
   // frozen it reached the goal on none of the development or premise scenes it flew
   // (docs/results/look_then_fly).
