@@ -132,6 +132,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
       lookFirst(from_here, built.map, clear_m, &a)) {
     if (!a.record.ok) return a;  // no view to look from: the vehicle holds
     a.trajectory = *a.raw;       // its yaws are the views it chose: no look-ahead
+    a.chosen_views = true;
     a.map = std::move(built.map);
     return a;
   }

@@ -242,8 +242,9 @@ class OnlinePlanning {
   double blindTolerance() const { return scenario_.planner.perception.selection.blind_tolerance_m; }
   // Flies a (a plan with a trajectory) from tau_switch, simulated time t_switch, on.
   void adopt(Attempt* a, double tau_switch, double t_switch, bool before_start);
-  // Renews the views ahead with a's (renewedViews, then the look-ahead), and returns the renewed
-  // trajectory before the look-ahead: the plan's own views along the route (nothing: not renewed).
+  // Renews the views ahead with a's (renewedViews, then the look-ahead unless they are the look
+  // search's), and returns the renewed trajectory before the look-ahead: the plan's own views along
+  // the route (nothing: not renewed).
   std::optional<control::SetpointTrajectory> renewViews(const Attempt& a, double tau_switch);
   // a's record's flown_* (and own_min_p from `own`, its time base's start at tau_switch when
   // own_from_start): the current trajectory's views from tau_switch on, which is simulated time
@@ -302,8 +303,10 @@ struct OnlinePlanning::Attempt {
   std::optional<control::SetpointTrajectory> trajectory;  // the planner's, after the look-ahead rule
   std::optional<control::SetpointTrajectory> raw;         // the planner's
   std::optional<planner::FeatureMap> map;                 // the snapshot it planned on
-  bool stops_short = false;              // its trajectory ends before the path does (stop_before_unknown)
-  std::optional<planner::Pose4> look;    // trial.look_then_fly: its trajectory ends at this look pose
+  bool stops_short = false;            // its trajectory ends before the path does (stop_before_unknown)
+  std::optional<planner::Pose4> look;  // trial.look_then_fly: its trajectory ends at this look pose
+  // ... its yaws are the search's views (a look or its way to the goal): no look-ahead, also renewed
+  bool chosen_views = false;
   std::vector<Eigen::Vector2d> watched;  // ... whose view is to observe these unknown columns (centres)
 };
 

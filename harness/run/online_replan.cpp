@@ -65,7 +65,11 @@ void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahea
 std::optional<control::SetpointTrajectory> OnlinePlanning::renewViews(const Attempt& a, double tau_switch) {
   std::optional<control::SetpointTrajectory> renewed =
       renewedViews(*current_, *a.raw, tau_switch, scenario_.planner.trajectory.max_yaw_rate_rad_s);
-  if (renewed) switchTo(a.look ? *renewed : lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  // The search's views stay its own when renewed, as when first flown (plan()); before, the look-ahead
+  // turned a renewed way to the goal toward the way ahead: blind, as rated, on detour-1009.
+  if (renewed) {
+    switchTo(a.chosen_views ? *renewed : lookAhead(*renewed, *a.map, *a.run.voxels), tau_switch, cfg_.blend_s);
+  }
   return renewed;
 }
 

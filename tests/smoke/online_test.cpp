@@ -368,6 +368,38 @@ TEST(OnlineTrial, ALookIsFlownToItsViewBeforeAnotherPlanIsFlown) {
   EXPECT_GE(checked, 2);
 }
 
+TEST(OnlineTrial, TheLookSearchsWayToTheGoalKeepsItsViewsWhenTheyAreRenewed) {
+  // trial.look_then_fly: a look, or the search's way to the goal, is flown with the views the
+  // search chose, without the look-ahead; so where every plan flown is one of them, the look-ahead's
+  // settings change nothing. Before, renewing the views of a way to the goal (a later plan along
+  // the same route) added the look-ahead: here the flights parted 0.5 s after the first renewal, and
+  // on detour-1009 it turned the camera to a view the plan itself rated blind (VO lost 0.9 m from
+  // the goal).
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 5" + kSmall +
+                           " --set trial.max_flight_s=40 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=0 --set trial.map_range_m=4";
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.look_ahead_s=0 --out " + (dir / "none").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.look_ahead_s=3 --set trial.look_ahead_always=true --out " +
+                               (dir / "always").string()))
+                .rc,
+            0);
+  int ways = 0;
+  int renewed = 0;
+  const nlohmann::json plans = readJson(dir / "always/online.json")["plans"];
+  for (const nlohmann::json& p : plans) {
+    const bool flown = p["adopted"].get<bool>() || p["views_renewed"].get<bool>();
+    if (!flown) continue;
+    ASSERT_EQ(p["look_pose"].size(), 4U) << "a plan flown at " << p["t_s"] << " s is not the look search's";
+    ways += p["look_goal"].get<bool>() ? 1 : 0;
+    renewed += p["look_goal"].get<bool>() && p["views_renewed"].get<bool>() ? 1 : 0;
+  }
+  std::cout << "[ figure   ] plans flown to the goal by the search's way: " << ways << ", of them renewed: " << renewed
+            << "\n";
+  EXPECT_GE(renewed, 1);  // the case this test is about
+  EXPECT_EQ(readText(dir / "none/gt.tum"), readText(dir / "always/gt.tum"));
+}
+
 TEST(OnlineTrial, LookFallbackFliesTheRouteWhereTheLastFailedLookWouldEndTheTrial) {
   // With a detection floor no view meets, the look search never finds a look. Without
   // trial.look_fallback the vehicle holds, and three failed plans in a row end the trial (no_path);
