@@ -117,6 +117,9 @@ void OnlineConfig::validate() const {
           "must be in (0, 100]");
   require(std::isfinite(guard_lead_s) && guard_lead_s >= 0.0 && guard_lead_s <= 5.0, "guard_lead_s", guard_lead_s,
           "must be in [0, 5]");
+  if (guard_still && !guard_tracking) {
+    throw std::invalid_argument("guard_still = true: needs guard_tracking = true (it is how the guard trips)");
+  }
   require(map_every_frames >= 1 && map_every_frames <= 100, "map_every_frames", map_every_frames,
           "must be in [1, 100]");
   require(std::isfinite(map_range_m) && map_range_m > 0.0 && map_range_m <= 100.0, "map_range_m", map_range_m,

@@ -404,7 +404,7 @@ void OnlinePlanning::makeGuard(const Intrinsics& camera) {
     lead = GuardLead{cfg_.guard_lead_s, camera, static_cast<double>(scenario_.vo.features.edge_threshold_px)};
   }
   guard_.emplace(cfg_.guard_inliers, kGuardMinTurnRad, 0.5 * scenario_.planner.perception.visibility.hfov_rad,
-                 cfg_.guard_range_m, lead);
+                 cfg_.guard_range_m, lead, cfg_.guard_still);
 }
 
 void OnlinePlanning::startFlight(const Intrinsics& camera, double trajectory_start_s) {

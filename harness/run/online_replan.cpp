@@ -110,7 +110,7 @@ void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo:
   const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers, &frame.inlier_columns);
   if (!wedge) return;
   wedges_.push_back(*wedge);
-  result_.guards.push_back(GuardEvent{t_s, yaw, good, inliers, *wedge});
+  result_.guards.push_back(GuardEvent{t_s, yaw, good, inliers, guard_->lastTripTurned(), *wedge});
   const double tau_now = tau(t_s, trajectory_start_s);
   const planner::Pose4 hold{current_->sample(tau_now).p_WB, good};
   // A reflex, not a plan: it stops within kGuardBlendS (a deceleration of about 1.3 m/s^2 at 0.4 m/s).

@@ -77,15 +77,23 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
     rearm_ = false;
     return std::nullopt;
   }
-  if (!armed_ || !has_good_ || std::abs(turning) < min_turn_rad_) return std::nullopt;
+  if (!armed_ || !has_good_) return std::nullopt;
+  const bool turned_enough = std::abs(turning) >= min_turn_rad_;
+  if (!turned_enough && !still_) return std::nullopt;
   armed_ = false;
+  last_trip_turned_ = turned_enough;
+  BlindWedge w;
+  w.apex = p;
+  w.range_m = range_m_;
+  if (!turned_enough) {  // the view lost as the vehicle moved: its field of view
+    w.from_rad = wrapAngle(yaw_rad - half_fov_rad_);
+    w.width_rad = 2.0 * half_fov_rad_;
+    return w;
+  }
   // The new part of the view: from the good view's edge on the side turned to, to the bad view's
   // far edge and kBeyondRad on.
   const double turned = std::abs(wrapAngle(yaw_rad - good_yaw_rad_));
   const double width = std::min(M_PI, turned + std::abs(lead_rad) + kBeyondRad);
-  BlindWedge w;
-  w.apex = p;
-  w.range_m = range_m_;
   w.width_rad = width;
   w.from_rad =
       turning > 0.0 ? wrapAngle(good_yaw_rad_ + half_fov_rad_) : wrapAngle(good_yaw_rad_ - half_fov_rad_ - width);
@@ -123,6 +131,7 @@ void markFree(octomap::OcTree* tree, const std::vector<Eigen::Vector3d>& centres
 bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m,
                  double beyond_rad) {
   if ((event.wedge.apex.head<2>() - p).norm() > within_m) return false;
+  if (!event.turning) return std::abs(std::remainder(yaw_rad - event.yaw_rad, 2.0 * M_PI)) <= 0.5 * beyond_rad;
   const double turn = std::remainder(event.yaw_rad - event.good_yaw_rad, 2.0 * M_PI);
   const double sign = turn >= 0.0 ? 1.0 : -1.0;
   const double along = sign * std::remainder(yaw_rad - event.good_yaw_rad, 2.0 * M_PI);  // in the turn's direction

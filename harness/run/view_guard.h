@@ -10,6 +10,10 @@
 // bad view's far edge and kBeyondRad on) becomes a blind wedge. Unknown space inside a wedge, within its range of the
 // place it was seen from, is planned as occupied: the vehicle does not fly into space it cannot
 // look at while the VO tracks. Observed space inside it is planned as it is.
+//
+// With `still` (trial.guard_still) it trips as well where the camera does not turn: the texture
+// leaves the image as the vehicle moves (it slides along a wall whose texture ends). The vehicle
+// stops while the VO still tracks, and the wedge is the view it lost: its field of view.
 #include <octomap/OcTree.h>
 
 #include <Eigen/Core>
@@ -43,11 +47,13 @@ struct GuardEvent {
   double yaw_rad = 0.0;       // the camera's (estimated) at the frame that tripped it
   double good_yaw_rad = 0.0;  // the last yaw that tracked enough
   int inliers = 0;
-  BlindWedge wedge;  // its apex: where the camera was (estimated)
+  bool turning = true;  // false: tripped without a turn (trial.guard_still); its wedge is the view lost
+  BlindWedge wedge;     // its apex: where the camera was (estimated)
 };
 
 // Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
-// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it.
+// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it; for a trip
+// without a turn, within half of beyond_rad of its yaw either way.
 bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m, double beyond_rad);
 
 // How many of a frame's inliers (vo::FrameResult::inlier_columns, binned across `camera`'s image)
@@ -77,24 +83,28 @@ class ViewGuard {
   // The lead's turn rate: over this long (three frames at 20 Hz).
   static constexpr double kRateWindowS = 0.15;
 
-  // half_fov_rad: half the camera's horizontal field of view.
-  ViewGuard(int min_inliers, double min_turn_rad, double half_fov_rad, double range_m, GuardLead lead = {})
+  // half_fov_rad: half the camera's horizontal field of view. still: it trips without a turn too.
+  ViewGuard(int min_inliers, double min_turn_rad, double half_fov_rad, double range_m, GuardLead lead = {},
+            bool still = false)
       : min_inliers_(min_inliers),
         min_turn_rad_(min_turn_rad),
         half_fov_rad_(half_fov_rad),
         range_m_(range_m),
-        lead_(lead) {}
+        lead_(lead),
+        still_(still) {}
 
   // One tracked frame: the camera's position and yaw (estimated) and the VO's inliers (with a
   // lead, `columns`: where they lie across the image). Returns the blind wedge when the guard
   // trips; it then stays disarmed until rearm(). With a lead, the wedge reaches past the bad view
-  // by the turn the lead foresaw as well.
+  // by the turn the lead foresaw as well. Without a turn (with `still`), the wedge is the bad view's
+  // field of view, and lastTripTurned() is false.
   std::optional<BlindWedge> observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers,
                                     const std::array<int, vo::FrameResult::kColumnBins>* columns = nullptr);
   // Arms it again from the next frame that tracks enough (a new plan is flown).
   void rearm() { rearm_ = true; }
   bool armed() const { return armed_; }
   double goodYaw() const { return good_yaw_rad_; }
+  bool lastTripTurned() const { return last_trip_turned_; }
 
  private:
   int min_inliers_;
@@ -102,6 +112,8 @@ class ViewGuard {
   double half_fov_rad_;
   double range_m_;
   GuardLead lead_;
+  bool still_ = false;
+  bool last_trip_turned_ = true;
   bool armed_ = true;
   bool rearm_ = false;
   bool has_good_ = false;

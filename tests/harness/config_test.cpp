@@ -425,6 +425,11 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_then_fly = true;
   EXPECT_EQ(invalidArgument(t), "");
   t = TrialConfig{};
+  t.online.guard_still = true;
+  EXPECT_EQ(invalidArgument(t), "guard_still = true: needs guard_tracking = true (it is how the guard trips)");
+  t.online.guard_tracking = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
   t.online.look_stall_s = 60.0;
   EXPECT_EQ(invalidArgument(t), "look_stall_s > 0: needs look_then_fly = true (it is when the looks have stalled)");
   t.online.look_then_fly = true;

@@ -71,6 +71,40 @@ TEST(ViewGuard, ATurnToTheRightBlamesTheBearingsRightOfTheGoodView) {
   EXPECT_FALSE(inWedge(*r, at(right_edge - 0.1, 3.5)));  // beyond its range
 }
 
+TEST(ViewGuard, StillItTripsWithoutATurnAndBlamesTheViewItLost) {
+  ViewGuard g(150, 5.0 * kDeg, kHalfFov, 3.0, GuardLead{}, /*still=*/true);
+  const Eigen::Vector3d p(1.0, 2.0, 1.0);
+  const double yaw = 0.5;
+  EXPECT_FALSE(g.observe(0.0, p, yaw, 40).has_value());  // nothing tracked well yet
+  EXPECT_FALSE(g.observe(0.05, p, yaw, 400).has_value());
+  // The texture leaves the image while the camera keeps its yaw (1 deg over 0.5 s).
+  const auto w = g.observe(0.40, p, yaw + 1.0 * kDeg, 149);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_FALSE(g.lastTripTurned());
+  auto at = [&](double bearing, double range) {
+    return Eigen::Vector3d(p.x() + range * std::cos(bearing), p.y() + range * std::sin(bearing), 1.0);
+  };
+  // The bad view's field of view, out to the range: ahead and near both edges, not beyond them.
+  EXPECT_TRUE(inWedge(*w, at(yaw, 2.0)));
+  EXPECT_TRUE(inWedge(*w, at(yaw + kHalfFov - 0.02, 2.0)));
+  EXPECT_TRUE(inWedge(*w, at(yaw - kHalfFov + 0.05, 2.0)));
+  EXPECT_FALSE(inWedge(*w, at(yaw + kHalfFov + 0.05, 2.0)));
+  EXPECT_FALSE(inWedge(*w, at(yaw - kHalfFov - 0.05, 2.0)));
+  EXPECT_FALSE(inWedge(*w, at(yaw, 3.5)));
+  // A turn still trips it as before, and says so.
+  g.rearm();
+  EXPECT_FALSE(g.observe(0.45, p, yaw, 400).has_value());
+  ASSERT_TRUE(g.observe(0.50, p, yaw + 10.0 * kDeg, 100).has_value());
+  EXPECT_TRUE(g.lastTripTurned());
+  // The view it lost is ruled out for the look search near where it tripped, either side of its yaw.
+  GuardEvent still{0.4, yaw, yaw, 149, /*turning=*/false, *w};
+  const Eigen::Vector2d here = p.head<2>();
+  EXPECT_TRUE(trippedView(still, here, yaw + 0.4 * kHalfFov, 1.0, kHalfFov));
+  EXPECT_TRUE(trippedView(still, here, yaw - 0.4 * kHalfFov, 1.0, kHalfFov));
+  EXPECT_FALSE(trippedView(still, here, yaw + 0.6 * kHalfFov, 1.0, kHalfFov));
+  EXPECT_FALSE(trippedView(still, here + Eigen::Vector2d(1.5, 0.0), yaw, 1.0, kHalfFov));
+}
+
 using Columns = std::array<int, vo::FrameResult::kColumnBins>;
 
 // 640 px wide, 90 deg across: fx = 320.
