@@ -200,8 +200,9 @@ struct OnlineConfig {
   // 3/10 (seeds 21-30, flown only after the fix of 7ca8608 was frozen; docs/results/renew).
   bool renew_views = true;
   // The tracking guard (harness/run/view_guard.h; the built-in planners, flying on the estimate):
-  // a frame the VO tracks with fewer than guard_inliers inliers, 5 deg or more from the last
-  // frame that tracked enough, stops the vehicle and turns the camera back there, and the plans
+  // a frame the VO tracks with fewer than guard_inliers inliers while the camera turns (5 deg or
+  // more over the last 0.5 s), stops the vehicle and turns the camera back to the last yaw that
+  // tracked enough, and the plans
   // from then on take the unknown space that turn looked toward, within guard_range_m of where it
   // was, as occupied. guard_inliers 150 (5 times vo.min_inliers) and guard_range_m 3 were chosen,
   // not fitted.
@@ -214,9 +215,9 @@ struct OnlineConfig {
   // 0.6 s and left off: storage never lost the VO, but 8 of 10 flights stalled (docs/results/lead).
   double guard_lead_s = 0.0;
   // true: the guard trips where the camera does not turn as well (ViewGuard's `still`): the texture
-  // leaves the image as the vehicle moves (premise detour-1009 lost the VO 0.5 m from the goal so,
-  // sliding along a wall whose texture ended; development 5004 and premise 1003 before). The wedge is
-  // then the view lost. false: only a turn trips it.
+  // leaves the image as the vehicle moves (development 5004 and premise 1003 lost the VO so). The
+  // wedge is then the view lost. false: only a turn trips it. Probed, not adopted: it saved 5004
+  // but not premise 1009, where the estimate drifted before it tripped (docs/results/advance).
   bool guard_still = false;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
