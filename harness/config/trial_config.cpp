@@ -109,6 +109,10 @@ void OnlineConfig::validate() const {
   if (look_stall_s > 0.0 && !look_then_fly) {
     throw std::invalid_argument("look_stall_s > 0: needs look_then_fly = true (it is when the looks have stalled)");
   }
+  if (look_keep_class && !look_then_fly) {
+    throw std::invalid_argument(
+        "look_keep_class = true: needs look_then_fly = true (it keeps the class the explorer flies)");
+  }
   require(look_give_up >= 0 && look_give_up <= 1000, "look_give_up", look_give_up, "must be in [0, 1000]");
   require(std::isfinite(look_min_detections) && look_min_detections >= 0.0 && look_min_detections <= 10000.0,
           "look_min_detections", look_min_detections, "must be in [0, 10000]");

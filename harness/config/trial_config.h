@@ -185,6 +185,16 @@ struct OnlineConfig {
   // Measured, not adopted: development 3/8 against 4/8 without it, two VO losses where the guard's
   // trips then left only the blind route (docs/results/advance).
   double look_stall_s = 0.0;
+  // With look_then_fly (the proposed planner): the explorer keeps the homology class it last flew.
+  // A plan whose choice is another class flies the candidate of the class in force instead (its H-
+  // signature on the plan's map, from the vehicle's place along the route last adopted), unless that
+  // candidate is blind for longer (planner.selection.blind_tolerance_m more) or longer (route_margin
+  // of the choice's length), as keep_route judges a route. false: each plan's choice. The explorer's
+  // classes cost nearly the same through unknown space, and it went back and forth between them
+  // (development detour-5003 for 220 s; gallery seed 1 flew 4 m back along a class it had left, a
+  // route planned through a block then unknown, whose class it no longer finds). Measured on
+  // development scenes only, not adopted: 5/8 against 4/8 (docs/results/advance).
+  bool look_keep_class = false;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the
   // current view over its inliers, where that is lower (LookConfig::tracked_inliers): the model
@@ -265,6 +275,7 @@ struct OnlineConfig {
     a("look_probe", look_probe);
     a("look_fallback", look_fallback);
     a("look_stall_s", look_stall_s);
+    a("look_keep_class", look_keep_class);
     a("look_calibrate_floor", look_calibrate_floor);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);

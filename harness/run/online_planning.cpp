@@ -112,6 +112,7 @@ OnlinePlanning::Attempt OnlinePlanning::plan(const planner::Pose4& start, double
       from_here.planner.oracle_class = -1;
       a.run = runPlanner(from_here, built.map, planner_, seed_, rrt_samples_, "planner.oracle_class", unknown_free);
     }
+    if (cfg_.look_keep_class) keepClass(&from_here, built.map, &a);
     a.record.voxel_map_s += a.run.voxel_map_s;
     a.record.solve_s += a.run.solve_s;
     a.record.trajectory_s = a.run.trajectory_s;

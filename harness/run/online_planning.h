@@ -52,6 +52,8 @@ struct OnlinePlan {
   // trajectory's positions are kept and its yaw ahead becomes the new plan's at the nearest point
   // (then the look-ahead rule on the current map), blended in over trial.blend_s.
   bool views_renewed = false;
+  // trial.look_keep_class: the class last flown was planned again in its place (classInForce).
+  bool kept_class = false;
   std::string detail;    // why not, when it failed
   planner::Pose4 start;  // where it starts (the estimated frame)
   // > 0: the point on the current trajectory where it would have started lay within the robot
@@ -137,6 +139,12 @@ bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m);
 // choice by more than `blind_tolerance_m`, or longer than it by more than `margin` times the
 // choice's length.
 bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin);
+
+// trial.look_keep_class: the index into plan.candidates (and plan.topo.classes) of the class that
+// `route`, the planner's route last adopted (from where it was planned to the goal), follows from
+// `start` on: that route from its point nearest `start`, with `start` before it, has the class's
+// H-signature around the plan's obstacles. -1: none does, or its candidate is not feasible.
+int classInForce(const planner::Plan& plan, const std::vector<Eigen::Vector2d>& route, const Eigen::Vector2d& start);
 
 class OnlinePlanning {
  public:
@@ -231,6 +239,9 @@ class OnlinePlanning {
   std::vector<Eigen::Vector3d> positionsAhead(double tau_from) const;
   // a.record's chosen_blind_m and route_blind_m, the route being `ahead` (positionsAhead).
   static void rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a);
+  // trial.look_keep_class: where the plan's choice leaves the class in force for a candidate not
+  // worth it (worthLeavingRoute), plans that class instead (`from_here` as the plan was asked).
+  void keepClass(Scenario* from_here, const planner::FeatureMap& map, Attempt* a);
   // trial.look_then_fly: the current trajectory is a look (or an advance) not yet at its end at
   // tau_now. It is flown to its end, where its view is, and a plan asked before then is not flown (its
   // map lacks that view) unless the path ahead is blocked or the guard trips. Before, the commit
@@ -293,6 +304,8 @@ class OnlinePlanning {
   std::vector<planner::Pose4> looked_;       // trial.look_then_fly: the look poses flown to
   LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
+  // trial.look_keep_class: the planner's route last adopted (2D)
+  std::vector<Eigen::Vector2d> class_route_;
   OnlineResult result_;
 };
 

@@ -10,6 +10,7 @@
 #include "harness/run/look_ahead.h"
 #include "harness/run/online_planning.h"
 #include "harness/run/view_guard.h"
+#include "planner/topological_planner.h"
 
 namespace tgnav::harness {
 
@@ -45,6 +46,51 @@ bool leavesBlindRoute(const OnlinePlan& plan, double tolerance_m) {
 bool worthLeavingRoute(const OnlinePlan& plan, double blind_tolerance_m, double margin) {
   if (plan.route_blind_m < 0.0 || plan.chosen_blind_m < 0.0) return true;
   return leavesBlindRoute(plan, blind_tolerance_m) || plan.route_length_m > (1.0 + margin) * plan.chosen_length_m;
+}
+
+int classInForce(const planner::Plan& plan, const std::vector<Eigen::Vector2d>& route, const Eigen::Vector2d& start) {
+  if (route.empty()) return -1;
+  std::size_t nearest = 0;
+  for (std::size_t i = 1; i < route.size(); ++i) {
+    if ((route[i] - start).norm() < (route[nearest] - start).norm()) nearest = i;
+  }
+  std::vector<Eigen::Vector2d> from_here{start};
+  from_here.insert(from_here.end(), route.begin() + static_cast<std::ptrdiff_t>(nearest), route.end());
+  const std::vector<double> signature = planner::windingAngles(from_here, plan.topo.obstacle_points);
+  const std::size_t n = std::min(plan.topo.classes.size(), plan.candidates.size());
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!planner::TopologicalPlanner::sameClass(plan.topo.classes[k].h_signature, signature)) continue;
+    return plan.candidates[k].feasible ? static_cast<int>(k) : -1;
+  }
+  return -1;
+}
+
+void OnlinePlanning::keepClass(Scenario* from_here, const planner::FeatureMap& map, Attempt* a) {
+  if (planner_ != planner::PlannerKind::kProposed || from_here->planner.oracle_class >= 0) return;
+  const planner::Plan& plan = a->run.plan;
+  if (plan.chosen < 0) return;
+  const int k = classInForce(plan, class_route_, from_here->scene.start.p_WB.head<2>());
+  if (k < 0 || k == plan.chosen) return;
+  const planner::CandidatePath& choice = plan.candidates[static_cast<std::size_t>(plan.chosen)];
+  const planner::CandidatePath& kept = plan.candidates[static_cast<std::size_t>(k)];
+  OnlinePlan judged;
+  judged.chosen_blind_m = choice.blind_length_m;
+  judged.chosen_length_m = choice.length_m;
+  judged.route_blind_m = kept.blind_length_m;
+  judged.route_length_m = kept.length_m;
+  if (worthLeavingRoute(judged, blindTolerance(), cfg_.route_margin)) return;
+  from_here->planner.oracle_class = k;  // the same map and seed: the same classes, in the same order
+  PlanRun again = runPlanner(*from_here, map, planner_, seed_, rrt_samples_, "planner.oracle_class",
+                             cfg_.unknown_space == UnknownSpace::kFree);
+  from_here->planner.oracle_class = -1;
+  // Both plans' time counts (the caller adds the one kept).
+  const bool kept_ok = again.plan.chosen >= 0 && again.trajectory.trajectory;
+  const PlanRun& spent = kept_ok ? a->run : again;
+  a->record.voxel_map_s += spent.voxel_map_s;
+  a->record.solve_s += spent.solve_s;
+  if (!kept_ok) return;  // the choice stays
+  a->run = std::move(again);
+  a->record.kept_class = true;
 }
 
 void OnlinePlanning::rateRouteBlindness(const std::vector<Eigen::Vector3d>& ahead, Attempt* a) {
@@ -137,6 +183,10 @@ void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool 
   last_change_s_ = a->record.t_s;
   switchTo(*a->trajectory, tau_switch, before_start ? 0.0 : cfg_.blend_s);
   rateFlownViews(a->raw ? &*a->raw : nullptr, true, tau_switch, t_switch, a);
+  if (cfg_.look_keep_class) {
+    class_route_.clear();
+    for (const Eigen::Vector3d& p : a->record.path) class_route_.push_back(p.head<2>());
+  }
   failed_in_a_row_ = 0;
   holding_ = false;
   if (guard_) guard_->rearm();

@@ -206,6 +206,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["ok"] = p.ok;
     j["adopted"] = p.adopted;
     j["views_renewed"] = p.views_renewed;
+    j["kept_class"] = p.kept_class;
     j["detail"] = p.detail;
     j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
     j["start_shift_m"] = p.start_shift_m;

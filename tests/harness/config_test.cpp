@@ -419,6 +419,12 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_advance = true;
   EXPECT_EQ(invalidArgument(t), "");
   t = TrialConfig{};
+  t.online.look_keep_class = true;
+  EXPECT_EQ(invalidArgument(t),
+            "look_keep_class = true: needs look_then_fly = true (it keeps the class the explorer flies)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
   t.online.look_fallback = true;
   EXPECT_EQ(invalidArgument(t),
             "look_fallback = true: needs look_then_fly = true (it is what a plan does when no look is left)");

@@ -444,5 +444,36 @@ TEST(WorthLeavingRoute, OnlyForARouteGoneBlinderOrLongerByTheMargin) {
   EXPECT_TRUE(worthLeavingRoute(p, 0.5, 10.0));
 }
 
+// trial.look_keep_class: the class in force is the one the route last adopted follows from the
+// vehicle's place on, by H-signature around the plan's obstacles (one here, at the origin).
+TEST(ClassInForce, TheClassTheRouteLastAdoptedFollowsFromHere) {
+  planner::Plan plan;
+  plan.topo.obstacle_points = {Eigen::Vector2d(0.0, 0.0)};
+  const std::vector<std::vector<Eigen::Vector2d>> classes = {{{-3.0, 0.0}, {0.0, 2.0}, {3.0, 0.0}},    // north of it
+                                                             {{-3.0, 0.0}, {0.0, -2.0}, {3.0, 0.0}}};  // south of it
+  for (const std::vector<Eigen::Vector2d>& path : classes) {
+    planner::HomologyClass c;
+    c.path = path;
+    c.h_signature = planner::windingAngles(path, plan.topo.obstacle_points);
+    plan.topo.classes.push_back(c);
+    plan.candidates.emplace_back();
+  }
+  const Eigen::Vector2d here(-3.0, 0.0);
+  // Adopted from farther back, south of the obstacle, and bent where it was then unknown.
+  const std::vector<Eigen::Vector2d> south = {{-6.0, 0.0}, {-4.0, -1.0}, {-1.0, -3.0}, {1.0, -1.0}, {3.0, 0.0}};
+  EXPECT_EQ(classInForce(plan, south, here), 1);
+  // The vehicle off the route (a look pose): it joins the route at its nearest point.
+  EXPECT_EQ(classInForce(plan, south, Eigen::Vector2d(-3.5, 0.5)), 1);
+  const std::vector<Eigen::Vector2d> north = {{-6.0, 0.0}, {-2.0, 1.5}, {3.0, 0.0}};
+  EXPECT_EQ(classInForce(plan, north, here), 0);
+  plan.candidates[0].feasible = false;  // its class has no 4-DoF path here
+  EXPECT_EQ(classInForce(plan, north, here), -1);
+  EXPECT_EQ(classInForce(plan, {}, here), -1);  // nothing adopted yet
+  // A route around the obstacle once more than either class: none.
+  const std::vector<Eigen::Vector2d> around = {{-3.0, 0.0}, {0.0, 2.0}, {2.0, 0.0}, {0.0, -2.0},
+                                               {-2.0, 0.0}, {0.0, 2.5}, {3.0, 0.0}};
+  EXPECT_EQ(classInForce(plan, around, here), -1);
+}
+
 }  // namespace
 }  // namespace tgnav::harness
