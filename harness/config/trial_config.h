@@ -191,9 +191,9 @@ struct OnlineConfig {
   // candidate is blind for longer (planner.selection.blind_tolerance_m more) or longer (route_margin
   // of the choice's length), as keep_route judges a route. false: each plan's choice. The explorer's
   // classes cost nearly the same through unknown space, and it went back and forth between them
-  // (development detour-5003 for 220 s; gallery seed 1 flew 4 m back along a class it had left, a
-  // route planned through a block then unknown, whose class it no longer finds). Measured on
-  // development scenes only, not adopted: 5/8 against 4/8 (docs/results/advance).
+  // (development detour-5003 for 220 s; gallery seed 1 flew 4 m back along a class it had left,
+  // and this did not keep it there). Measured on development scenes only, not adopted: 5/8 against
+  // 4/8 (docs/results/advance).
   bool look_keep_class = false;
   // With look_then_fly, flying on the VO: where the last frame kept at least guard_inliers inliers,
   // the detection floor drops to guard_inliers times the detections the model expects of the
