@@ -54,6 +54,12 @@ struct OnlinePlan {
   bool views_renewed = false;
   // trial.look_keep_class: the class last flown was planned again in its place (classInForce).
   bool kept_class = false;
+  // ... the class in force on this plan's map (-1: none matched, or not asked: nothing adopted yet,
+  // or no choice), and its candidate's blind length and length (-1 where none): where it is not
+  // kept, what leaving it was judged on (worthLeavingRoute).
+  int class_in_force = -1;
+  double in_force_blind_m = -1.0;
+  double in_force_length_m = -1.0;
   std::string detail;    // why not, when it failed
   planner::Pose4 start;  // where it starts (the estimated frame)
   // > 0: the point on the current trajectory where it would have started lay within the robot

@@ -70,9 +70,13 @@ void OnlinePlanning::keepClass(Scenario* from_here, const planner::FeatureMap& m
   const planner::Plan& plan = a->run.plan;
   if (plan.chosen < 0) return;
   const int k = classInForce(plan, class_route_, from_here->scene.start.p_WB.head<2>());
-  if (k < 0 || k == plan.chosen) return;
-  const planner::CandidatePath& choice = plan.candidates[static_cast<std::size_t>(plan.chosen)];
+  a->record.class_in_force = k;
+  if (k < 0) return;
   const planner::CandidatePath& kept = plan.candidates[static_cast<std::size_t>(k)];
+  a->record.in_force_blind_m = kept.blind_length_m;
+  a->record.in_force_length_m = kept.length_m;
+  if (k == plan.chosen) return;
+  const planner::CandidatePath& choice = plan.candidates[static_cast<std::size_t>(plan.chosen)];
   OnlinePlan judged;
   judged.chosen_blind_m = choice.blind_length_m;
   judged.chosen_length_m = choice.length_m;

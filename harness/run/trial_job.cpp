@@ -207,6 +207,9 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["adopted"] = p.adopted;
     j["views_renewed"] = p.views_renewed;
     j["kept_class"] = p.kept_class;
+    j["class_in_force"] = p.class_in_force;
+    j["in_force_blind_m"] = p.in_force_blind_m;
+    j["in_force_length_m"] = p.in_force_length_m;
     j["detail"] = p.detail;
     j["start"] = {p.start.p_WB.x(), p.start.p_WB.y(), p.start.p_WB.z(), p.start.yaw_rad};
     j["start_shift_m"] = p.start_shift_m;

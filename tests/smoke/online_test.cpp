@@ -530,5 +530,47 @@ TEST(OnlineTrialCli, BadInputIsOneLineExit2AndWritesNothing) {
   }
 }
 
+// trial.look_keep_class: once a route is adopted, each plan records the class in force on its own
+// map; a plan whose choice leaves it plans that class instead (kept_class), unless the choice is
+// worth it (worthLeavingRoute: the class in force blind for more than blind_tolerance_m longer, 0.5
+// m in configs/planner.yaml, or longer by route_margin, 0.2). On the smoke scene (seed 3, 4 classes)
+// the choice leaves the class in force, and it is kept.
+TEST(OnlineTrial, KeepingTheClassPlansTheClassInForceUnlessTheChoiceIsWorthLeavingItFor) {
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall +
+                           " --set trial.max_flight_s=14 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=0 --set trial.look_keep_class=true"
+                           " --set planner.topology.max_classes=4";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + dir.string())).rc, 0);
+  const nlohmann::json plans = readJson(dir / "online.json")["plans"];
+  int kept = 0;
+  int in_force = 0;
+  bool adopted = false;
+  for (const nlohmann::json& p : plans) {
+    const int k = p["class_in_force"].get<int>();
+    if (!adopted) {
+      EXPECT_EQ(k, -1) << "nothing adopted yet at " << p["t_s"];
+    }
+    adopted = adopted || p["adopted"].get<bool>();
+    if (!p["ok"].get<bool>() || k < 0) {
+      EXPECT_FALSE(p["kept_class"].get<bool>()) << p["t_s"];
+      continue;
+    }
+    ++in_force;
+    if (p["kept_class"].get<bool>()) {
+      ++kept;
+      EXPECT_EQ(p["chosen_class"].get<int>(), k) << p["t_s"];  // the class in force is what it flies
+      EXPECT_DOUBLE_EQ(p["chosen_length_m"].get<double>(), p["in_force_length_m"].get<double>()) << p["t_s"];
+    } else if (p["chosen_class"].get<int>() != k) {  // left for a choice worth it
+      const double blind = p["in_force_blind_m"].get<double>();
+      const double length = p["in_force_length_m"].get<double>();
+      EXPECT_TRUE(blind > p["chosen_blind_m"].get<double>() + 0.5 || length > 1.2 * p["chosen_length_m"].get<double>())
+          << p["t_s"];
+    }
+  }
+  EXPECT_GT(in_force, 3);
+  EXPECT_GT(kept, 0);
+}
+
 }  // namespace
 }  // namespace tgnav
