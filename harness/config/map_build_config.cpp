@@ -13,6 +13,7 @@ void MapBuildConfig::validate() const {
   require(min_observations >= 1, "min_observations", min_observations, "must be >= 1");
   require(max_shift_m >= 0.0, "max_shift_m", max_shift_m, "must be >= 0");
   require(depth_edge_m > 0.0, "depth_edge_m", depth_edge_m, "must be > 0");
+  require(no_return_depth_m >= 0.0, "no_return_depth_m", no_return_depth_m, "must be >= 0");
   camera.validate();
   features.validate();
 }

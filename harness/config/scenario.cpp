@@ -12,6 +12,7 @@
 #include "harness/base/errors.h"
 #include "harness/base/files.h"
 #include "harness/config/config_io.h"
+#include "harness/config/map_build_config.h"
 #include "harness/config/track_model_file.h"
 #include "harness/config/vehicle_config.h"
 
@@ -208,6 +209,20 @@ void resolveExternalDir(const YamlDoc& doc, const YamlDoc* overrides, PlannerSet
   ext.dir = dir.string();
 }
 
+// trial.map_clear_no_return needs depth left to clear: InputError naming the camera's settings.
+void checkNoReturnDepth(const YamlDoc& doc, const YamlDoc* overrides, const Scenario& s) {
+  if (!s.trial.online.map_clear_no_return) return;
+  const double depth = noReturnDepth(s.camera);
+  if (depth > kMinNoReturnDepthM) return;
+  std::ostringstream msg;
+  const bool overridden = overrides && (overrides->root()["trial"] || overrides->root()["camera"]);
+  msg << doc.file().string() << (overridden ? " (with --set overrides)" : "")
+      << ": key 'trial.map_clear_no_return' is true, but camera.max_depth_m " << s.camera.max_depth_m
+      << " less three sigmas of its depth noise (camera.depth_noise_sigma_per_m2 " << s.camera.depth_noise_sigma_per_m2
+      << ") leaves " << depth << " m to clear (needs > " << kMinNoReturnDepthM << ")";
+  throw InputError(msg.str());
+}
+
 YAML::Node poseYaml(const planner::Pose4& pose) {
   const double v[4] = {pose.p_WB.x(), pose.p_WB.y(), pose.p_WB.z(), pose.yaw_rad};
   return exactSequence(v, 4);
@@ -251,6 +266,7 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
   s.visitSections(sections);
   readTrackModel(doc, overrides, &s.planner);
   resolveExternalDir(doc, overrides, &s.planner);
+  checkNoReturnDepth(doc, overrides, s);
   return s;
 }
 

@@ -241,6 +241,12 @@ struct OnlineConfig {
   // The online map's depth rays clear free space only short of the surface they hit
   // (MapBuildConfig::free_short_of_surface).
   bool map_short_of_surface = false;
+  // A depth pixel without a return (nothing within the camera's range, camera.max_depth_m) clears
+  // the unobserved space along its ray to that range less three sigmas of its depth noise, within
+  // map_range_m (MapBuildConfig::no_return_depth_m): down a corridor longer than the camera's
+  // range the space at flight height is otherwise never observed, and look_then_fly never flies
+  // it. false: such pixels are skipped.
+  bool map_clear_no_return = false;
   // Simulated time from take-off; beyond it the flight stops. 300 s: gallery's online flight on
   // the true pose alone took 115 s for its 38 m (docs/results/online10/truth), so 120 s stopped
   // flights that were still tracking and making way.
@@ -287,6 +293,7 @@ struct OnlineConfig {
     a("map_stride_px", map_stride_px);
     a("map_range_m", map_range_m);
     a("map_short_of_surface", map_short_of_surface);
+    a("map_clear_no_return", map_clear_no_return);
     a("max_flight_s", max_flight_s);
   }
 

@@ -170,8 +170,13 @@ void IncrementalMapper::setPrior(const octomap::OcTree& occupancy, std::vector<p
 void IncrementalMapper::insertDepth(const RgbdFrame& frame, int stride_px) {
   if (config_.free_short_of_surface) {
     insertDepthShortOfSurface(frame, stride_px);
-    return;
+  } else {
+    insertDepthRays(frame, stride_px);
   }
+  if (config_.no_return_depth_m > 0.0) clearNoReturn(frame, stride_px);
+}
+
+void IncrementalMapper::insertDepthRays(const RgbdFrame& frame, int stride_px) {
   const Eigen::Vector3d origin = frame.X_WC.translation();
   octomap::Pointcloud cloud;
   for (int v = 0; v < k_.height_px; v += stride_px) {
@@ -247,6 +252,29 @@ void IncrementalMapper::insertDepthShortOfSurface(const RgbdFrame& frame, int st
     if (occupied_cells.count(key) == 0) tree_->updateNode(key, false);
   }
   for (const octomap::OcTreeKey& key : occupied_cells) tree_->updateNode(key, true);
+}
+
+void IncrementalMapper::clearNoReturn(const RgbdFrame& frame, int stride_px) {
+  const octomap::point3d o = planner::toOcto(frame.X_WC.translation());
+  octomap::KeySet free_cells;
+  octomap::KeyRay ray;
+  for (int v = 0; v < k_.height_px; v += stride_px) {
+    const float* row = frame.depth_m.ptr<float>(v);
+    for (int u = 0; u < k_.width_px; u += stride_px) {
+      if (row[u] > 0.0F) continue;
+      const Eigen::Vector3d dir_C = Eigen::Vector3d((u - k_.cx) / k_.fx, (v - k_.cy) / k_.fy, 1.0).normalized();
+      const double length = std::min(config_.max_range_m, config_.no_return_depth_m / dir_C.z());
+      const octomap::point3d e = planner::toOcto(frame.X_WC * (length * dir_C));
+      if (tree_->computeRayKeys(o, e, ray)) free_cells.insert(ray.begin(), ray.end());
+      octomap::OcTreeKey key;
+      if (tree_->coordToKeyChecked(e, key)) free_cells.insert(key);
+    }
+  }
+  // Only voxels not observed yet: a ray without a return says nothing against a surface another
+  // ray saw (a voxel it crosses at a corner may hold one).
+  for (const octomap::OcTreeKey& key : free_cells) {
+    if (tree_->search(key) == nullptr) tree_->updateNode(key, false);
+  }
 }
 
 void IncrementalMapper::observeFeatures(const RgbdFrame& frame) {

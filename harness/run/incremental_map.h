@@ -59,7 +59,8 @@ class IncrementalMapper {
   void setPrior(const octomap::OcTree& occupancy, std::vector<planner::Landmark> landmarks);
 
   // Ray-inserts every `stride_px`-th depth pixel of `frame` at frame.X_WC (short of the surface
-  // with config.free_short_of_surface).
+  // with config.free_short_of_surface; with config.no_return_depth_m, the pixels without depth
+  // too).
   void insertDepth(const RgbdFrame& frame, int stride_px);
   // Detects its ORB keypoints, merges those with a stable depth into the landmarks, and keeps a
   // sampled depth of the view for counting opportunities.
@@ -96,7 +97,9 @@ class IncrementalMapper {
     int opportunities = 0;
   };
   Built build(std::unique_ptr<octomap::OcTree> tree);
+  void insertDepthRays(const RgbdFrame& frame, int stride_px);
   void insertDepthShortOfSurface(const RgbdFrame& frame, int stride_px);
+  void clearNoReturn(const RgbdFrame& frame, int stride_px);
 
   MapBuildConfig config_;
   Intrinsics k_;

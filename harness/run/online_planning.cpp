@@ -24,11 +24,13 @@ namespace {
 constexpr double kBlockedHorizonS = 10.0;
 constexpr double kBlockedStepS = 0.1;
 
-MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const OnlineConfig& online) {
+MapBuildConfig onlineMapConfig(const planner::FeatureMap& survey, const Scenario& scenario) {
+  const OnlineConfig& online = scenario.trial.online;
   MapBuildConfig config;
   config.resolution_m = survey.resolution();
   config.max_range_m = online.map_range_m;
   config.free_short_of_surface = online.map_short_of_surface;
+  if (online.map_clear_no_return) config.no_return_depth_m = noReturnDepth(scenario.camera);  // checked at loading
   return config;
 }
 
@@ -41,7 +43,7 @@ OnlinePlanning::OnlinePlanning(const Scenario& scenario, const planner::FeatureM
       planner_(planner),
       seed_(seed),
       rrt_samples_(rrt_samples),
-      mapper_(onlineMapConfig(survey, scenario.trial.online)),
+      mapper_(onlineMapConfig(survey, scenario)),
       external_(external ? std::make_unique<ExternalPlannerSession>() : nullptr) {
   if (scenario.planner.oracle_class >= 0) {
     throw InputError("planner.oracle_class = " + std::to_string(scenario.planner.oracle_class) +

@@ -600,6 +600,20 @@ TEST_F(ConfigScenario, ValidationFailureNamesTheAssignmentOrTheFile) {
   EXPECT_EQ(error(scenario("trial: {goal_radius_m: 0}\n"), {}), file.string() + ": goal_radius_m = 0: must be > 0");
 }
 
+// trial.map_clear_no_return clears to the camera's max depth less three sigmas of its depth noise:
+// a camera whose noise leaves nothing is named with both its settings.
+TEST_F(ConfigScenario, ClearingWithoutAReturnNeedsDepthLeftAfterTheNoise) {
+  const auto file = scenario("trial: {map_clear_no_return: true}\n");
+  EXPECT_EQ(error(file, {}), "");
+  EXPECT_EQ(error(file, {"camera.depth_noise_sigma_per_m2=0.002"}), "");  // 10 m less 0.6 m
+  EXPECT_EQ(error(file, {"camera.depth_noise_sigma_per_m2=0.05"}),
+            file.string() +
+                " (with --set overrides): key 'trial.map_clear_no_return' is true, but camera.max_depth_m 10 less "
+                "three sigmas of its depth noise (camera.depth_noise_sigma_per_m2 0.05) leaves -5 m to clear "
+                "(needs > 0.5)");
+  EXPECT_EQ(error(scenario(""), {"camera.depth_noise_sigma_per_m2=0.05"}), "");  // the option off
+}
+
 TEST_F(ConfigScenario, LayersDefaultsFileInlineAndOverrides) {
   test::writeFile(dir_ / "cam.yaml", "width_px: 400\nheight_px: 300\nnear_clip_m: 0.06\nrgb_noise_sigma: 1\n");
   test::writeFile(dir_ / "trial.yaml", "state_source: vo\ncamera_rate_hz: 25\nflight: {hold_s: 3}\n");

@@ -149,5 +149,40 @@ TEST(IncrementalMapper, RaysThatGrazeAWallClearItsVoxelsUnlessTheyStopShortOfThe
   EXPECT_EQ(kept[1], occupied_before);
 }
 
+// A camera's depth has no return beyond its range. Looking along the wall (at x 2.01, to the
+// camera's right), the pixels to its left see nothing within 8 m: with no_return_depth_m their rays
+// mark the space they cross free, within max_range_m; without it that space stays unobserved. A
+// voxel observed occupied stays so, though later views without any return cross it.
+TEST(IncrementalMapper, PixelsWithoutDepthClearOnlyUnobservedSpaceWithinRangeWhenAsked) {
+  const Intrinsics k = intrinsicsFromFovy(60.0, 320, 240);
+  const auto beyondRange = [](RgbdFrame f) {
+    cv::Mat far = f.depth_m > 8.0F;
+    f.depth_m.setTo(0.0F, far);
+    return f;
+  };
+  const auto state = [](const IncrementalMapper& m, const Eigen::Vector3d& c) {
+    const octomap::OcTreeNode* n = m.occupancy().search(c.x(), c.y(), c.z());
+    return n == nullptr ? 'u' : m.occupancy().isNodeOccupied(n) ? 'o' : 'f';
+  };
+  const Eigen::Vector3d left_near(-1.0, 5.0, 0.0);  // 5 m ahead, 1 m left: no surface behind it
+  const Eigen::Vector3d left_far(-1.0, 7.5, 0.0);   // ... beyond max_range_m
+  const Eigen::Vector3d wall(2.05, 0.05, 0.05);     // the wall's voxel in front of the camera
+  for (const double no_return_m : {0.0, 8.0}) {
+    MapBuildConfig config;
+    config.max_range_m = 6.0;
+    config.no_return_depth_m = no_return_m;
+    IncrementalMapper m(config, k);
+    m.insertDepth(wallFrame(k, lookingAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX())), 2);
+    ASSERT_EQ(state(m, wall), 'o');
+    m.insertDepth(beyondRange(wallFrame(k, lookingAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY()))), 2);
+    EXPECT_EQ(state(m, left_near), no_return_m > 0.0 ? 'f' : 'u') << "no_return_depth_m " << no_return_m;
+    EXPECT_EQ(state(m, left_far), 'u') << "no_return_depth_m " << no_return_m;
+    RgbdFrame blank = wallFrame(k, lookingAlong(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()));
+    blank.depth_m.setTo(0.0F);
+    for (int i = 0; i < 5; ++i) m.insertDepth(blank, 2);  // five misses would clear a hit
+    EXPECT_EQ(state(m, wall), 'o') << "no_return_depth_m " << no_return_m;
+  }
+}
+
 }  // namespace
 }  // namespace tgnav::harness
