@@ -121,6 +121,10 @@ void OnlineConfig::validate() const {
           "must be in (0, 100]");
   require(std::isfinite(guard_lead_s) && guard_lead_s >= 0.0 && guard_lead_s <= 5.0, "guard_lead_s", guard_lead_s,
           "must be in [0, 5]");
+  if (guard_planned_turn && !(guard_tracking && guard_lead_s > 0.0)) {
+    throw std::invalid_argument(
+        "guard_planned_turn = true: needs guard_tracking = true and guard_lead_s > 0 (it is what the lead foresees)");
+  }
   if (guard_still && !guard_tracking) {
     throw std::invalid_argument("guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   }

@@ -229,6 +229,13 @@ struct OnlineConfig {
   // wedge is then the view lost. false: only a turn trips it. Probed, not adopted: it saved 5004
   // but not premise 1009, where the estimate drifted before it tripped (docs/results/advance).
   bool guard_still = false;
+  // With guard_lead_s > 0: the lead also foresees the turn the trajectory being flown commands over
+  // the next guard_lead_s (its yaw then less its yaw now), and takes the larger of that and the turn
+  // at the measured rate; a commanded turn of at least the guard's minimum turn counts as a turn,
+  // so the guard can trip before the camera starts it. false: the measured rate alone, which is
+  // still small when a turn starts (gallery with route_mean: it tripped 0.1 s before the loss;
+  // docs/results/no_return).
+  bool guard_planned_turn = false;
   int map_every_frames = 4;  // every Nth camera frame goes into the map (a keyframe)
   int map_stride_px = 8;     // ... every Nth pixel of its depth, in both directions
   // Depth within this range goes into the map, and the features there become landmarks: the
@@ -289,6 +296,7 @@ struct OnlineConfig {
     a("guard_range_m", guard_range_m);
     a("guard_lead_s", guard_lead_s);
     a("guard_still", guard_still);
+    a("guard_planned_turn", guard_planned_turn);
     a("map_every_frames", map_every_frames);
     a("map_stride_px", map_stride_px);
     a("map_range_m", map_range_m);

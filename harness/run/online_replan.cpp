@@ -157,11 +157,19 @@ void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo:
   const Eigen::Vector3d axis = X_WC.linear().col(2);  // the optical axis
   const double yaw = std::atan2(axis.y(), axis.x());
   const double good = guard_->goodYaw();
-  const std::optional<BlindWedge> wedge = guard_->observe(t_s, X_WC.translation(), yaw, inliers, &frame.inlier_columns);
+  const double tau_now = tau(t_s, trajectory_start_s);
+  // trial.guard_planned_turn: the turn the trajectory commands over the lead.
+  const double planned =
+      cfg_.guard_planned_turn
+          ? std::remainder(current_->sample(tau_now + cfg_.guard_lead_s).yaw_rad - current_->sample(tau_now).yaw_rad,
+                           2.0 * M_PI)
+          : 0.0;
+  const std::optional<BlindWedge> wedge =
+      guard_->observe(t_s, X_WC.translation(), yaw, inliers, &frame.inlier_columns, planned);
   if (!wedge) return;
   wedges_.push_back(*wedge);
-  result_.guards.push_back(GuardEvent{t_s, yaw, good, inliers, guard_->lastTripTurned(), *wedge});
-  const double tau_now = tau(t_s, trajectory_start_s);
+  result_.guards.push_back(
+      GuardEvent{t_s, yaw, good, inliers, guard_->lastTripTurned(), *wedge, guard_->lastTripPlannedRad()});
   const planner::Pose4 hold{current_->sample(tau_now).p_WB, good};
   // A reflex, not a plan: it stops within kGuardBlendS (a deceleration of about 1.3 m/s^2 at 0.4 m/s).
   constexpr double kGuardBlendS = 0.3;

@@ -255,6 +255,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
                       {"good_yaw_rad", g.good_yaw_rad},
                       {"inliers", g.inliers},
                       {"turning", g.turning},
+                      {"planned_rad", g.planned_rad},
                       {"wedge_from_rad", g.wedge.from_rad},
                       {"wedge_width_rad", g.wedge.width_rad},
                       {"wedge_range_m", g.wedge.range_m}});

@@ -57,7 +57,8 @@ int inliersAfterTurn(const std::array<int, vo::FrameResult::kColumnBins>& column
 }
 
 std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers,
-                                             const std::array<int, vo::FrameResult::kColumnBins>* columns) {
+                                             const std::array<int, vo::FrameResult::kColumnBins>* columns,
+                                             double planned_turn_rad) {
   recent_.emplace_back(t_s, yaw_rad);
   while (recent_.size() > 1 && recent_[1].first <= t_s - kTurnWindowS + 1e-9) recent_.pop_front();
   const double turning = wrapAngle(yaw_rad - recent_.front().second);
@@ -68,7 +69,10 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
   });
   const double span_s = t_s - from->first;
   const double rate = span_s > 0.0 ? wrapAngle(yaw_rad - from->second) / span_s : 0.0;
-  const double lead_rad = lead_.lead_s > 0.0 && columns != nullptr ? rate * lead_.lead_s : 0.0;
+  const bool leads = lead_.lead_s > 0.0 && columns != nullptr;
+  // The commanded turn, where it is the larger: a turn about to start has no rate yet.
+  const bool planned = leads && std::abs(planned_turn_rad) > std::abs(rate * lead_.lead_s);
+  const double lead_rad = !leads ? 0.0 : planned ? planned_turn_rad : rate * lead_.lead_s;
   if (lead_rad != 0.0) inliers = std::min(inliers, inliersAfterTurn(*columns, lead_.camera, lead_rad, lead_.edge_px));
   if (inliers >= min_inliers_) {
     has_good_ = true;
@@ -78,10 +82,12 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
     return std::nullopt;
   }
   if (!armed_ || !has_good_) return std::nullopt;
-  const bool turned_enough = std::abs(turning) >= min_turn_rad_;
+  const bool turned = std::abs(turning) >= min_turn_rad_;
+  const bool turned_enough = turned || (planned && std::abs(planned_turn_rad) >= min_turn_rad_);
   if (!turned_enough && !still_) return std::nullopt;
   armed_ = false;
   last_trip_turned_ = turned_enough;
+  last_trip_planned_rad_ = planned && turned_enough ? planned_turn_rad : 0.0;
   BlindWedge w;
   w.apex = p;
   w.range_m = range_m_;
@@ -92,11 +98,11 @@ std::optional<BlindWedge> ViewGuard::observe(double t_s, const Eigen::Vector3d& 
   }
   // The new part of the view: from the good view's edge on the side turned to, to the bad view's
   // far edge and kBeyondRad on.
-  const double turned = std::abs(wrapAngle(yaw_rad - good_yaw_rad_));
-  const double width = std::min(M_PI, turned + std::abs(lead_rad) + kBeyondRad);
+  const double so_far = std::abs(wrapAngle(yaw_rad - good_yaw_rad_));
+  const double width = std::min(M_PI, so_far + std::abs(lead_rad) + kBeyondRad);
+  const double side = turned ? turning : lead_rad;  // a turn not yet started: the one commanded
   w.width_rad = width;
-  w.from_rad =
-      turning > 0.0 ? wrapAngle(good_yaw_rad_ + half_fov_rad_) : wrapAngle(good_yaw_rad_ - half_fov_rad_ - width);
+  w.from_rad = side > 0.0 ? wrapAngle(good_yaw_rad_ + half_fov_rad_) : wrapAngle(good_yaw_rad_ - half_fov_rad_ - width);
   return w;
 }
 
@@ -132,7 +138,7 @@ bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_r
                  double beyond_rad) {
   if ((event.wedge.apex.head<2>() - p).norm() > within_m) return false;
   if (!event.turning) return std::abs(std::remainder(yaw_rad - event.yaw_rad, 2.0 * M_PI)) <= 0.5 * beyond_rad;
-  const double turn = std::remainder(event.yaw_rad - event.good_yaw_rad, 2.0 * M_PI);
+  const double turn = std::remainder(event.yaw_rad - event.good_yaw_rad, 2.0 * M_PI) + event.planned_rad;
   const double sign = turn >= 0.0 ? 1.0 : -1.0;
   const double along = sign * std::remainder(yaw_rad - event.good_yaw_rad, 2.0 * M_PI);  // in the turn's direction
   return along >= 0.5 * std::abs(turn) && along <= std::abs(turn) + beyond_rad;

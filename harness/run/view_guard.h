@@ -49,11 +49,15 @@ struct GuardEvent {
   int inliers = 0;
   bool turning = true;  // false: tripped without a turn (trial.guard_still); its wedge is the view lost
   BlindWedge wedge;     // its apex: where the camera was (estimated)
+  // The commanded turn the lead foresaw and tripped on (trial.guard_planned_turn), else 0: the turn
+  // toward the bad view is then yaw_rad - good_yaw_rad plus this.
+  double planned_rad = 0.0;
 };
 
 // Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
-// tripped, from halfway through its turn to beyond_rad past the yaw that tripped it; for a trip
-// without a turn, within half of beyond_rad of its yaw either way.
+// tripped, from halfway through its turn (with the commanded turn it foresaw, event.planned_rad) to
+// beyond_rad past its end; for a trip without a turn, within half of beyond_rad of its yaw either
+// way.
 bool trippedView(const GuardEvent& event, const Eigen::Vector2d& p, double yaw_rad, double within_m, double beyond_rad);
 
 // How many of a frame's inliers (vo::FrameResult::inlier_columns, binned across `camera`'s image)
@@ -97,14 +101,19 @@ class ViewGuard {
   // lead, `columns`: where they lie across the image). Returns the blind wedge when the guard
   // trips; it then stays disarmed until rearm(). With a lead, the wedge reaches past the bad view
   // by the turn the lead foresaw as well. Without a turn (with `still`), the wedge is the bad view's
-  // field of view, and lastTripTurned() is false.
+  // field of view, and lastTripTurned() is false. planned_turn_rad (trial.guard_planned_turn): the
+  // turn the trajectory commands over the lead; where it is larger than the turn at the measured
+  // rate the lead foresees it instead, and at min_turn_rad or more it counts as a turn
+  // (lastTripPlannedRad() then returns it).
   std::optional<BlindWedge> observe(double t_s, const Eigen::Vector3d& p, double yaw_rad, int inliers,
-                                    const std::array<int, vo::FrameResult::kColumnBins>* columns = nullptr);
+                                    const std::array<int, vo::FrameResult::kColumnBins>* columns = nullptr,
+                                    double planned_turn_rad = 0.0);
   // Arms it again from the next frame that tracks enough (a new plan is flown).
   void rearm() { rearm_ = true; }
   bool armed() const { return armed_; }
   double goodYaw() const { return good_yaw_rad_; }
   bool lastTripTurned() const { return last_trip_turned_; }
+  double lastTripPlannedRad() const { return last_trip_planned_rad_; }
 
  private:
   int min_inliers_;
@@ -114,6 +123,7 @@ class ViewGuard {
   GuardLead lead_;
   bool still_ = false;
   bool last_trip_turned_ = true;
+  double last_trip_planned_rad_ = 0.0;
   bool armed_ = true;
   bool rearm_ = false;
   bool has_good_ = false;

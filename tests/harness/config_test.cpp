@@ -436,6 +436,14 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.guard_tracking = true;
   EXPECT_EQ(invalidArgument(t), "");
   t = TrialConfig{};
+  t.online.guard_planned_turn = true;
+  t.online.guard_tracking = true;
+  EXPECT_EQ(
+      invalidArgument(t),
+      "guard_planned_turn = true: needs guard_tracking = true and guard_lead_s > 0 (it is what the lead foresees)");
+  t.online.guard_lead_s = 0.6;
+  EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
   t.online.look_stall_s = 60.0;
   EXPECT_EQ(invalidArgument(t), "look_stall_s > 0: needs look_then_fly = true (it is when the looks have stalled)");
   t.online.look_then_fly = true;

@@ -151,6 +151,35 @@ TEST(ViewGuard, WithALeadItTripsBeforeTheTextureAtTheTrailingEdgeLeavesTheImage)
   EXPECT_LT(fly(crowded, 0.0).first, 0.0);  // no lead: the inliers alone, still 600
 }
 
+TEST(ViewGuard, WithThePlannedTurnItTripsBeforeTheTurnStarts) {
+  // At rest, 600 inliers 20-100 px from the image's left edge; the trajectory commands a turn to the
+  // right of 0.36 rad over the 0.6 s lead, which would take every one of them out. Measured, the
+  // camera has not turned at all.
+  Columns crowded{};
+  for (std::size_t b = 1; b <= 4; ++b) crowded[b] = 150;
+  const Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  const double yaw = 0.2;
+  auto first = [&](double planned_rad) {
+    ViewGuard g(150, 5.0 * kDeg, kHalfFov, 3.0, GuardLead{0.6, camera(), 19.0});
+    EXPECT_FALSE(g.observe(0.0, p, yaw, 600, &crowded).has_value());  // nothing commanded yet
+    auto w = g.observe(0.05, p, yaw, 600, &crowded, planned_rad);
+    return std::make_pair(w, g.lastTripPlannedRad());
+  };
+  const auto [w, planned] = first(-0.36);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_DOUBLE_EQ(planned, -0.36);
+  // The wedge lies on the right of the good view, over the commanded turn and beyond.
+  EXPECT_NEAR(w->width_rad, 0.36 + ViewGuard::kBeyondRad, 1e-9);
+  EXPECT_NEAR(w->from_rad, yaw - kHalfFov - w->width_rad, 1e-9);
+  EXPECT_FALSE(first(0.0).first.has_value());   // nothing commanded: the rate alone, zero
+  EXPECT_FALSE(first(0.36).first.has_value());  // a turn to the left keeps the points in view
+  // The look search rules out the views the commanded turn was heading to, not the good one.
+  const GuardEvent trip{0.05, yaw, yaw, 600, true, *w, planned};
+  EXPECT_TRUE(trippedView(trip, p.head<2>(), yaw - 0.3, 1.0, kHalfFov));
+  EXPECT_FALSE(trippedView(trip, p.head<2>(), yaw, 1.0, kHalfFov));
+  EXPECT_FALSE(trippedView(trip, p.head<2>(), yaw + 0.3, 1.0, kHalfFov));
+}
+
 TEST(BlockWedges, MarksOnlyUnknownSpaceInsideTheWedgeAwayFromKeptPlaces) {
   octomap::OcTree tree(0.1);
   // Observed free: a 1 m square right of the apex, ahead of the vehicle (x in [1, 2]).
