@@ -64,10 +64,9 @@ struct CorridorFrames {
     VehicleModel vehicle = loadVehicleModel(scene.mjcf);
     DataPtr data = makeData(vehicle.model.get());
     EglContext gl;
-    CameraConfig config;
-    config.depth_noise_sigma_per_m2 = 0.002;
-    Camera camera(vehicle.model.get(), gl, config.on("front"), 0);
-    CameraNoise noise(config, 1);
+    camera_config.depth_noise_sigma_per_m2 = 0.002;
+    Camera camera(vehicle.model.get(), gl, camera_config.on("front"), 0);
+    CameraNoise noise(camera_config, 1);
     k = camera.intrinsics();
     for (int i = 0; i < 8; ++i) {
       const planner::Pose4 pose{Eigen::Vector3d(4.0 - 0.5 * i, 8.4, 1.0), M_PI - 0.05 * (i % 3)};
@@ -77,6 +76,7 @@ struct CorridorFrames {
       frames.push_back(std::move(frame));
     }
   }
+  CameraConfig camera_config;
   Intrinsics k;
   std::vector<RgbdFrame> frames;
 };
@@ -88,7 +88,7 @@ void BM_InsertDepthDownCorridor(benchmark::State& state) {
   MapBuildConfig config;
   config.max_range_m = 10.0;
   config.free_short_of_surface = true;
-  config.no_return_depth_m = state.range(0) != 0 ? 10.0 - 3.0 * 0.002 * 100.0 : 0.0;
+  config.no_return_depth_m = state.range(0) != 0 ? noReturnDepth(corridor.camera_config) : 0.0;
   for (auto _ : state) {
     IncrementalMapper mapper(config, corridor.k);
     for (const RgbdFrame& f : corridor.frames) mapper.insertDepth(f, 8);
