@@ -223,6 +223,19 @@ void checkNoReturnDepth(const YamlDoc& doc, const YamlDoc* overrides, const Scen
   throw InputError(msg.str());
 }
 
+// trial.look_fov_margin_deg must leave a field of view: InputError naming both settings.
+void checkLookFovMargin(const YamlDoc& doc, const YamlDoc* overrides, const Scenario& s) {
+  const double margin_rad = s.trial.online.look_fov_margin_deg * M_PI / 180.0;
+  const double hfov_rad = s.planner.perception.visibility.hfov_rad;
+  if (2.0 * margin_rad < hfov_rad) return;
+  std::ostringstream msg;
+  const bool overridden = overrides && (overrides->root()["trial"] || overrides->root()["planner"]);
+  msg << doc.file().string() << (overridden ? " (with --set overrides)" : "") << ": key 'trial.look_fov_margin_deg' is "
+      << s.trial.online.look_fov_margin_deg << ", which on each side leaves nothing of planner.visibility.hfov_rad "
+      << hfov_rad << " (needs less than half of it)";
+  throw InputError(msg.str());
+}
+
 YAML::Node poseYaml(const planner::Pose4& pose) {
   const double v[4] = {pose.p_WB.x(), pose.p_WB.y(), pose.p_WB.z(), pose.yaw_rad};
   return exactSequence(v, 4);
@@ -267,6 +280,7 @@ Scenario loadScenario(const fs::path& yaml, const YamlDoc* overrides) {
   readTrackModel(doc, overrides, &s.planner);
   resolveExternalDir(doc, overrides, &s.planner);
   checkNoReturnDepth(doc, overrides, s);
+  checkLookFovMargin(doc, overrides, s);
   return s;
 }
 

@@ -116,6 +116,12 @@ void OnlineConfig::validate() const {
   require(look_give_up >= 0 && look_give_up <= 1000, "look_give_up", look_give_up, "must be in [0, 1000]");
   require(std::isfinite(look_min_detections) && look_min_detections >= 0.0 && look_min_detections <= 10000.0,
           "look_min_detections", look_min_detections, "must be in [0, 10000]");
+  require(std::isfinite(look_fov_margin_deg) && look_fov_margin_deg >= 0.0 && look_fov_margin_deg <= 45.0,
+          "look_fov_margin_deg", look_fov_margin_deg, "must be in [0, 45]");
+  if (look_fov_margin_deg > 0.0 && !look_then_fly) {
+    throw std::invalid_argument(
+        "look_fov_margin_deg > 0: needs look_then_fly = true (it narrows the views the explorer rates)");
+  }
   require(guard_inliers >= 1 && guard_inliers <= 10000, "guard_inliers", guard_inliers, "must be in [1, 10000]");
   require(std::isfinite(guard_range_m) && guard_range_m > 0.0 && guard_range_m <= 100.0, "guard_range_m", guard_range_m,
           "must be in (0, 100]");

@@ -152,6 +152,13 @@ struct OnlineConfig {
   // guard_inliers, chosen before any run: the model fitted with the paper's line of sight rated
   // views trackable where the VO found 50-80 features (docs/results/look_then_fly).
   double look_min_detections = 150.0;
+  // With look_then_fly, the search rates each view on the landmarks that stay in the image when the
+  // camera's yaw errs by up to this either way (the horizontal field of view narrowed by it on each
+  // side), not the whole image: its views with texture only at the image's edges were lost to the
+  // pose the vehicle really flew (gallery seed 1: a look rated 213-220 detections at its cells, all
+  // in strips at the edges, was flown 0.15 m off them, and the VO was lost at 49; the camera saw bare
+  // wall). 0: the whole image. Chosen, not fitted: 7.5, half the search's yaw step.
+  double look_fov_margin_deg = 0.0;
   // With look_then_fly, a goal-directed order of looks (LookConfig::advance): a look must observe
   // the robot's footprint of unknown space; where none observes the way on, the vehicle flies along
   // the route's observed part as far as the search reaches, and only then looks near the way on, then
@@ -283,6 +290,7 @@ struct OnlineConfig {
     a("stop_before_unknown", stop_before_unknown);
     a("look_then_fly", look_then_fly);
     a("look_min_detections", look_min_detections);
+    a("look_fov_margin_deg", look_fov_margin_deg);
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);

@@ -249,14 +249,9 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   look.probe = cfg_.look_probe;
   look.floor_inliers = cfg_.guard_inliers;
   if (cfg_.look_calibrate_floor && last_inliers_ >= cfg_.guard_inliers) look.tracked_inliers = last_inliers_;
-  // The views it flies must expect trial.look_min_detections detections (150 by default, what the
-  // tracking guard asks of inliers: the model fitted with the paper's line of sight alone rated views
-  // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
-  ViewRater rater(*a->run.voxels, perception.visibility, perception.information);
-  rater.setDetectionFloor(cfg_.look_min_detections);  // 0: none
   const LookMemory memory{visited_, looked_, givenUp(), result_.guards};
   const LookPlan found =
-      planLook(*a->run.voxels, rater, from_here.scene.start, scenario_.scene.goal.p_WB, route, way_on, memory, look);
+      searchLook(*a->run.voxels, from_here.scene.start, route, way_on, all_observed, memory, look, &a->record);
   a->record.look_cells = found.cells;
   // A route all observed that the search cannot fly with trackable views: flown as planned.
   if (all_observed && !found.goal) return false;
@@ -290,6 +285,40 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   if (!found.goal) a->look = found.path.back();
   a->watched = found.watched;
   return true;
+}
+
+LookPlan OnlinePlanning::searchLook(const planner::VoxelMap& voxels, const planner::Pose4& start,
+                                    const std::vector<Eigen::Vector3d>& route,
+                                    const std::vector<Eigen::Vector3d>& way_on, bool all_observed,
+                                    const LookMemory& memory, const LookConfig& look, OnlinePlan* record) const {
+  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
+  // The views it flies must expect trial.look_min_detections detections (150 by default, what the
+  // tracking guard asks of inliers: the model fitted with the paper's line of sight alone rated views
+  // trackable where the VO found 50-80 features for seconds and was lost: development scene detour-5003).
+  const auto search = [&](double margin_deg, std::vector<Eigen::Vector4d>* rated_path) {
+    planner::VisibilityConfig rated = perception.visibility;
+    rated.hfov_rad -= 2.0 * margin_deg * M_PI / 180.0;
+    ViewRater rater(voxels, rated, perception.information);
+    rater.setDetectionFloor(cfg_.look_min_detections);  // 0: none
+    LookPlan plan = planLook(voxels, rater, start, scenario_.scene.goal.p_WB, route, way_on, memory, look);
+    rated_path->clear();
+    for (const planner::Pose4& pose : plan.path) {
+      rater.moveTo(pose.p_WB);
+      rated_path->emplace_back(pose.p_WB.x(), pose.p_WB.y(), pose.yaw_rad, rater.detections(pose.yaw_rad));
+    }
+    return plan;
+  };
+  // trial.look_fov_margin_deg; where it leaves nothing to fly, the whole image before the route is flown
+  // unrated (with the margin alone, gallery seed 1 fell back 20 times, not 2, and lost the VO).
+  LookPlan found = search(cfg_.look_fov_margin_deg, &record->look_path);
+  const auto nothing_to_fly = [&](const LookPlan& p) { return p.path.size() < 2 || (all_observed && !p.goal); };
+  if (cfg_.look_fov_margin_deg > 0.0 && nothing_to_fly(found)) {
+    const int cells = found.cells;
+    found = search(0.0, &record->look_path);
+    found.cells += cells;
+    record->look_whole_fov = true;
+  }
+  return found;
 }
 
 void OnlinePlanning::noteLook(const Attempt& a) {

@@ -24,6 +24,7 @@
 
 #include "control/trajectory.h"
 #include "harness/config/scenario.h"
+#include "harness/run/explore.h"
 #include "harness/run/external_plan.h"
 #include "harness/run/incremental_map.h"
 #include "harness/run/look_columns.h"
@@ -91,10 +92,18 @@ struct OnlinePlan {
                                // (where this failure would have ended the trial)
   bool look_stall = false;     // trial.look_stall_s: the looks had stalled, and the route was flown as planned
   double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
+  // ... trial.look_fov_margin_deg: the search with the margin found nothing to fly, and this one was
+  // rated on the whole image (OnlinePlanning::searchLook)
+  bool look_whole_fov = false;
   // ... where its path ends (x, y, z, yaw: the look pose, or the advance's; empty: none) and the
   // unknown columns that view is to observe (LookPlan::watched, their centres)
   std::vector<double> look_pose;
   std::vector<Eigen::Vector2d> look_watched;
+  // ... its path (LookPlan::path: x, y, yaw per pose) and the detections the model expects of each
+  // pose's view on the plan's map (ViewRater::detections, all its landmarks, in the field of view the
+  // search rated: trial.look_fov_margin_deg; the search counted only those seen across observed
+  // columns), for reading a look against the VO's inliers where it flew
+  std::vector<Eigen::Vector4d> look_path;
   int look_cells = 0;       // cells whose views the search rated
   int landmarks = 0;        // in the map it planned on
   int prior_landmarks = 0;  // ... and those of trial.unseen_prior added to it (route_mean: to the class's map)
@@ -102,7 +111,8 @@ struct OnlinePlan {
   // this plan then flies (-1: none, or not asked)
   int rated_class = -1;
   // A flown plan (adopted, or its views renewed): the least trackable view the vehicle then flies
-  // until the next plan can take effect (its switch + replan_period_s), as this plan's map rates it
+  // until the next plan can take effect (its switch + replan_period_s; a look's end, where later),
+  // as this plan's map rates it
   // (worstView, frame_prediction.h, every kFlownViewStepS at the setpoints). The look-ahead and the
   // splice may fly views the plan did not choose: own_min_p is the least probability of the plan's
   // own views over the same time (its trajectory before the look-ahead; with the views renewed, the
@@ -226,6 +236,12 @@ class OnlinePlanning {
   // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
   // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
   bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
+  // planLook from `start` on `voxels` with the views rated as trial.look_fov_margin_deg and
+  // look_min_detections say (the margin dropped where it leaves nothing to fly); record's look_path
+  // and look_whole_fov say what it rated.
+  LookPlan searchLook(const planner::VoxelMap& voxels, const planner::Pose4& start,
+                      const std::vector<Eigen::Vector3d>& route, const std::vector<Eigen::Vector3d>& way_on,
+                      bool all_observed, const LookMemory& memory, const LookConfig& look, OnlinePlan* record) const;
   // An adopted plan's look pose: not chosen again, and its columns counted (watch_).
   void noteLook(const Attempt& a);
   // The columns trial.look_give_up looks were to observe (their centres).

@@ -127,7 +127,10 @@ void OnlinePlanning::rateFlownViews(const control::SetpointTrajectory* own, bool
                                     double t_switch, Attempt* a) const {
   if (!a->run.voxels) return;
   const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
-  const RatedView flown = worstView(*current_, tau_switch, cfg_.replan_period_s, kFlownViewStepS, *a->run.voxels,
+  // A look is flown to its end (lookInFlight): no later plan takes effect before then.
+  const double span_s =
+      looking_ ? std::max(cfg_.replan_period_s, current_->endTime() - tau_switch) : cfg_.replan_period_s;
+  const RatedView flown = worstView(*current_, tau_switch, span_s, kFlownViewStepS, *a->run.voxels,
                                     perception.visibility, perception.information);
   const double p = flown.prediction.track_probability;
   if (p < 0.0) return;  // no model
@@ -138,9 +141,9 @@ void OnlinePlanning::rateFlownViews(const control::SetpointTrajectory* own, bool
   r.flown_min_detections = flown.prediction.support.detections;
   if (own == nullptr || p >= perception.information.min_track_probability) return;
   const double from = own_from_start ? own->startTime() : tau_switch;
-  r.own_min_p = worstView(*own, from, cfg_.replan_period_s, kFlownViewStepS, *a->run.voxels, perception.visibility,
-                          perception.information)
-                    .prediction.track_probability;
+  r.own_min_p =
+      worstView(*own, from, span_s, kFlownViewStepS, *a->run.voxels, perception.visibility, perception.information)
+          .prediction.track_probability;
 }
 
 void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double tau_switch, double blend_s) {

@@ -227,10 +227,14 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["look_stall"] = p.look_stall;
     j["look_near"] = p.look_near;
     j["look_floor"] = p.look_floor;
+    j["look_whole_fov"] = p.look_whole_fov;
     j["look_pose"] = p.look_pose;
     nlohmann::ordered_json watched = nlohmann::ordered_json::array();
     for (const Eigen::Vector2d& c : p.look_watched) watched.push_back({c.x(), c.y()});
     j["look_watched"] = watched;
+    nlohmann::ordered_json look_path = nlohmann::ordered_json::array();
+    for (const Eigen::Vector4d& q : p.look_path) look_path.push_back({q.x(), q.y(), q.z(), q.w()});
+    j["look_path"] = look_path;  // x, y, yaw, expected detections
     j["look_cells"] = p.look_cells;
     j["landmarks"] = p.landmarks;
     j["prior_landmarks"] = p.prior_landmarks;

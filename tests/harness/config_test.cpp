@@ -431,6 +431,14 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_then_fly = true;
   EXPECT_EQ(invalidArgument(t), "");
   t = TrialConfig{};
+  t.online.look_fov_margin_deg = 7.5;
+  EXPECT_EQ(invalidArgument(t),
+            "look_fov_margin_deg > 0: needs look_then_fly = true (it narrows the views the explorer rates)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_fov_margin_deg = -1.0;
+  EXPECT_EQ(invalidArgument(t), "look_fov_margin_deg = -1: must be in [0, 45]");
+  t = TrialConfig{};
   t.online.guard_still = true;
   EXPECT_EQ(invalidArgument(t), "guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   t.online.guard_tracking = true;
@@ -620,6 +628,19 @@ TEST_F(ConfigScenario, ClearingWithoutAReturnNeedsDepthLeftAfterTheNoise) {
                 "three sigmas of its depth noise (camera.depth_noise_sigma_per_m2 0.05) leaves -5 m to clear "
                 "(needs > 0.5)");
   EXPECT_EQ(error(scenario(""), {"camera.depth_noise_sigma_per_m2=0.05"}), "");  // the option off
+}
+
+// trial.look_fov_margin_deg narrows the explorer's rated field of view on each side: a margin that
+// leaves none of the perception model's horizontal field is named with both settings.
+TEST_F(ConfigScenario, TheLooksFieldOfViewMarginMustLeaveAField) {
+  const auto file =
+      scenario("trial: {mode: online, state_source: vo, look_then_fly: true, look_fov_margin_deg: 7.5}\n");
+  EXPECT_EQ(error(file, {}), "");
+  EXPECT_EQ(error(file, {"trial.look_fov_margin_deg=37"}), "");  // 74 of the model's 75.2 deg
+  EXPECT_EQ(error(file, {"trial.look_fov_margin_deg=40"}),
+            file.string() +
+                " (with --set overrides): key 'trial.look_fov_margin_deg' is 40, which on each side leaves nothing "
+                "of planner.visibility.hfov_rad 1.3125 (needs less than half of it)");
 }
 
 TEST_F(ConfigScenario, LayersDefaultsFileInlineAndOverrides) {

@@ -352,6 +352,14 @@ TEST(OnlineTrial, ALookIsFlownToItsViewBeforeAnotherPlanIsFlown) {
       continue;
     }
     const std::vector<double> pose = look["look_pose"];
+    // The search's path is recorded, ending at the look pose, each pose with the detections the
+    // model expects of its view.
+    const nlohmann::json path = look["look_path"];
+    ASSERT_GE(path.size(), 2U);
+    EXPECT_NEAR(path.back()[0].get<double>(), pose[0], 1e-9);
+    EXPECT_NEAR(path.back()[1].get<double>(), pose[1], 1e-9);
+    EXPECT_NEAR(path.back()[2].get<double>(), pose[3], 1e-9);
+    for (const nlohmann::json& q : path) EXPECT_GE(q[3].get<double>(), 0.0);
     const double from_s = look["t_s"].get<double>();
     const double until_s = adopted[i + 1]["t_s"].get<double>() + 0.5;  // the next plan takes effect then
     bool held = false;
@@ -398,6 +406,33 @@ TEST(OnlineTrial, TheLookSearchsWayToTheGoalKeepsItsViewsWhenTheyAreRenewed) {
             << "\n";
   EXPECT_GE(renewed, 1);  // the case this test is about
   EXPECT_EQ(readText(dir / "none/gt.tum"), readText(dir / "always/gt.tum"));
+}
+
+TEST(OnlineTrial, AFieldOfViewMarginThatLeavesNoViewFliesTheLooksOfTheWholeImage) {
+  // trial.look_fov_margin_deg 37 leaves 1.2 deg of the 75.2 deg field: no view the search rates with
+  // it is trackable, so every look is searched again on the whole image (look_whole_fov) and the
+  // flight is the one without the margin. Without that second search, the route was flown unrated
+  // (gallery seed 1: 20 fallbacks, not 2, and the VO lost).
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall +
+                           " --set trial.max_flight_s=8 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=0 --set trial.commit_s=0";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "whole").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.look_fov_margin_deg=37 --out " + (dir / "margin").string())).rc, 0);
+  int looks = 0;
+  const nlohmann::json margin = readJson(dir / "margin/online.json")["plans"];
+  const nlohmann::json whole = readJson(dir / "whole/online.json")["plans"];
+  for (const nlohmann::json& p : margin) {
+    if (p["look_path"].empty()) continue;
+    EXPECT_TRUE(p["look_whole_fov"].get<bool>()) << "a look at " << p["t_s"] << " s";
+    ++looks;
+  }
+  for (const nlohmann::json& p : whole) {
+    EXPECT_FALSE(p["look_whole_fov"].get<bool>()) << "a plan at " << p["t_s"] << " s";  // no margin to drop
+  }
+  std::cout << "[ figure   ] looks searched again on the whole image: " << looks << "\n";
+  EXPECT_GE(looks, 1);
+  EXPECT_EQ(readText(dir / "whole/gt.tum"), readText(dir / "margin/gt.tum"));
 }
 
 TEST(OnlineTrial, LookFallbackFliesTheRouteWhereTheLastFailedLookWouldEndTheTrial) {
