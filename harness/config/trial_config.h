@@ -157,7 +157,9 @@ struct OnlineConfig {
   // side), not the whole image: its views with texture only at the image's edges were lost to the
   // pose the vehicle really flew (gallery seed 1: a look rated 213-220 detections at its cells, all
   // in strips at the edges, was flown 0.15 m off them, and the VO was lost at 49; the camera saw bare
-  // wall). 0: the whole image. Chosen, not fitted: 7.5, half the search's yaw step.
+  // wall). Where the margin leaves nothing to fly, the search is made again on the whole image
+  // (OnlinePlanning::searchLook). 0: the whole image. Measured at 7.5 deg, half the search's yaw step
+  // (chosen before any run, not fitted), and left off (docs/results/fov_margin).
   double look_fov_margin_deg = 0.0;
   // With look_then_fly, a goal-directed order of looks (LookConfig::advance): a look must observe
   // the robot's footprint of unknown space; where none observes the way on, the vehicle flies along
