@@ -50,7 +50,7 @@ std::string RgbdOdometry::updateLocalMap(const PreparedFrame& frame, const Local
     }
   }
   std::string keyframe = config_.keyframe_policy == KeyframePolicy::kRatio
-                             ? ratioRules(pose.inliers)
+                             ? ratioRules(pose.inliers, frame.with_depth)
                              : orbSlam2Rules(pose.inliers, frame, matched_landmark);
   if (!keyframe.empty()) addKeyframe(X_WC_, frame, matched_landmark, pose.inliers);
   // Cull landmarks that keep failing to match where they should be seen (after the keyframe
@@ -70,14 +70,17 @@ void addRule(bool fires, const char* name, std::string* rules) {
 
 }  // namespace
 
-// Keyframe (ratio): tracking thins out, or the camera moved or turned enough since the last one.
-std::string RgbdOdometry::ratioRules(int inliers) const {
+// Keyframe (ratio): tracking thins out, or the camera moved or turned enough since the last one,
+// or the view offers far more features with depth than the last one tracked and created.
+std::string RgbdOdometry::ratioRules(int inliers, int with_depth) const {
   const Keyframe& last = keyframes_.back();
   const Eigen::Isometry3d rel = last.X_WC.inverse() * X_WC_;
   std::string rules;
   addRule(inliers < config_.keyframe_inlier_ratio * last.tracked, "inliers", &rules);
   addRule(rel.translation().norm() > config_.keyframe_translation_m, "translation", &rules);
   addRule(rotationAngle(rel.linear()) > config_.keyframe_rotation_rad, "rotation", &rules);
+  addRule(config_.keyframe_richer_ratio > 0.0 && with_depth > config_.keyframe_richer_ratio * last.tracked, "richer",
+          &rules);
   return rules;
 }
 

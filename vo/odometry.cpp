@@ -202,6 +202,10 @@ void OdometryConfig::validate() const {
           "must be in (0, 1]");
   require(keyframe_translation_m > 0.0, "keyframe_translation_m", keyframe_translation_m, "must be > 0");
   require(keyframe_rotation_rad > 0.0, "keyframe_rotation_rad", keyframe_rotation_rad, "must be > 0");
+  require(keyframe_richer_ratio == 0.0 || (std::isfinite(keyframe_richer_ratio) && keyframe_richer_ratio > 1.0),
+          "keyframe_richer_ratio", keyframe_richer_ratio, "must be 0 (off) or > 1");
+  require(keyframe_richer_ratio == 0.0 || keyframe_policy == KeyframePolicy::kRatio, "keyframe_richer_ratio",
+          keyframe_richer_ratio, "applies to keyframe_policy ratio only (set it to 0 with orbslam2)");
   require(landmark_max_misses >= 1, "landmark_max_misses", landmark_max_misses, "must be >= 1");
   require(keyframe_reference_ratio > 0.0 && keyframe_reference_ratio <= 1.0, "keyframe_reference_ratio",
           keyframe_reference_ratio, "must be in (0, 1]");

@@ -10,9 +10,12 @@
 //
 // Keyframe policies. `ratio`: a keyframe when the inliers fall below keyframe_inlier_ratio of
 // those the last keyframe tracked and created, or the camera moved or turned far enough since
-// it. `orbslam2`: ORB-SLAM2's decision for an RGB-D camera (Tracking::NeedNewKeyFrame): the
-// frame tracks fewer than keyframe_reference_ratio (0.75; 0.4 while there is one keyframe) of the
-// reference keyframe's well-observed landmarks (observed twice or more: ORB-SLAM2 counts an
+// it, or (keyframe_richer_ratio r > 0) the frame has more than r times as many features with
+// depth as the last keyframe tracked and created: after a keyframe made in a near-blind view, a
+// view that offers far more than the map holds makes one (the inlier rule never fires there,
+// since the frame tracks more than the near-blind keyframe had). `orbslam2`: ORB-SLAM2's decision for an RGB-D camera
+// (Tracking::NeedNewKeyFrame): the frame tracks fewer than keyframe_reference_ratio (0.75; 0.4 while there is one
+// keyframe) of the reference keyframe's well-observed landmarks (observed twice or more: ORB-SLAM2 counts an
 // observation with depth twice and wants 3 counts, 2 while there are at most two keyframes), or
 // it tracks fewer than 100 close landmarks (depth below keyframe_close_depth_m) while 70 close
 // features are unmatched; and it tracks more than 15; and either keyframe_max_frames frames
@@ -102,6 +105,8 @@ struct OdometryConfig {
                                         // fraction of the last keyframe's
   double keyframe_translation_m = 0.4;  // ... or the camera moved this far
   double keyframe_rotation_rad = 0.35;  // ... or turned this much
+  double keyframe_richer_ratio = 0.0;   // ratio: ... or the frame's features with depth exceed
+                                        // this multiple of the last keyframe's (0: off; else > 1)
   int landmark_max_misses = 10;         // cull a landmark not matched in this many frames it was expected in
   KeyframePolicy keyframe_policy = KeyframePolicy::kRatio;
   double keyframe_reference_ratio = 0.75;  // orbslam2: ORB-SLAM2's thRefRatio for RGB-D
@@ -136,6 +141,7 @@ struct OdometryConfig {
     a("keyframe_inlier_ratio", keyframe_inlier_ratio);
     a("keyframe_translation_m", keyframe_translation_m);
     a("keyframe_rotation_rad", keyframe_rotation_rad);
+    a("keyframe_richer_ratio", keyframe_richer_ratio);
     a("landmark_max_misses", landmark_max_misses);
     a.choice("keyframe_policy", keyframe_policy, keyframePolicyNames());
     a("keyframe_reference_ratio", keyframe_reference_ratio);
@@ -170,7 +176,7 @@ struct FrameResult {
   std::array<int, kColumnBins> inlier_columns{};
   bool keyframe = false;      // this frame became a keyframe
   std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation);
-                              // ratio: "inliers", "translation", "rotation"; orbslam2: "reference",
+                              // ratio: "inliers", "translation", "rotation", "richer"; orbslam2: "reference",
                               // "close"; empty for other frames
   bool reinitialised = false;
   // For a frame where a bundle adjustment was applied (NaN otherwise; the keyframe itself with
@@ -283,9 +289,10 @@ class RgbdOdometry {
   int refinePose(const LocalMapMatches& matches, const std::vector<cv::Point3d>& object_in,
                  const std::vector<cv::Point2d>& pixels_in, const std::vector<double>& depth_in,
                  const Eigen::Isometry3d& start, Eigen::Isometry3d* X_CW, std::vector<bool>* is_inlier) const;
-  // The keyframe rules that fire ('+'-joined; empty: none): ratioRules for the current pose and
-  // inliers, orbSlam2Rules also from the frame's close features, tracked or not.
-  std::string ratioRules(int inliers) const;
+  // The keyframe rules that fire ('+'-joined; empty: none): ratioRules for the current pose,
+  // inliers and the frame's features with depth, orbSlam2Rules also from the frame's close
+  // features, tracked or not.
+  std::string ratioRules(int inliers, int with_depth) const;
   std::string orbSlam2Rules(int inliers, const PreparedFrame& frame, const std::vector<int>& matched_landmark) const;
   void addKeyframe(const Eigen::Isometry3d& X_WC, const PreparedFrame& frame, const std::vector<int>& matched_landmark,
                    int tracked);

@@ -240,6 +240,55 @@ TEST(Odometry, OrbSlam2KeyframePolicy) {
   EXPECT_LT(keyframes[1], keyframes[0]) << keyframes[0] << " ratio keyframes";
 }
 
+// keyframe_richer_ratio: a still camera sees the whole texture (every corner: no feature cap), a
+// view that narrows to a strip at its left edge (each narrowing a keyframe by the inlier rule; the
+// rest's landmarks, expected but unmatched, are culled while it stays there) and widens again. The
+// widening tracks the strip's landmarks, more than the strip's keyframe had, so the ratio rule
+// alone makes no keyframe once the inlier count stops falling, and the VO stays anchored to a
+// fifth of what it sees; with the rule at 2 a view with twice the features of the last keyframe
+// makes one ("richer"), and it tracks several times as many.
+TEST(Odometry, AViewFarRicherThanTheLastKeyframeMakesOneWithTheRicherRule) {
+  const cv::Mat tex = texture(kW, kH);
+  // Frames 5-10 narrow the view to a 36 px strip, 11-20 stay there, 21-25 widen it again.
+  const auto view = [&](int i) {
+    const int widths[] = {200, 140, 100, 70, 50, 36};
+    cv::Mat image = tex.clone();
+    const int w = i < 5 || i > 25 ? kW : widths[i < 20 ? std::min(i - 5, 5) : 25 - i];
+    if (w < kW) image(cv::Rect(w, 0, kW - w, kH)).setTo(cv::Scalar(128));
+    return image;
+  };
+  int end_inliers[2] = {0, 0};
+  for (const double richer : {0.0, 2.0}) {
+    OdometryConfig config;
+    config.keyframe_richer_ratio = richer;
+    config.features.max_features = 20000;  // every corner the view has: its texture limits them
+    RgbdOdometry vo(camera(), config);
+    int richer_alone = 0;  // keyframes the inlier rule did not ask for
+    FrameResult r;
+    for (int i = 0; i < 40; ++i) {
+      r = vo.track(0.05 * i, view(i), flatDepth());
+      ASSERT_NE(r.status, TrackingStatus::kLost) << "frame " << i << ": " << r.reason;
+      EXPECT_LT(r.X_WC.translation().norm(), 0.05) << "frame " << i;  // a 36 px strip pins little
+      const bool by_richer = r.keyframe_rule.find("richer") != std::string::npos;
+      if (richer == 0.0 || i <= 20) {
+        EXPECT_FALSE(by_richer) << "frame " << i;
+      }
+      if ((i > 10 && i <= 20) || (richer == 0.0 && i > 23)) {
+        EXPECT_FALSE(r.keyframe) << "frame " << i << ": " << r.keyframe_rule;
+      }
+      richer_alone += r.keyframe_rule == "richer" ? 1 : 0;
+    }
+    end_inliers[richer > 0.0 ? 1 : 0] = r.inliers;
+    if (richer == 0.0) {
+      EXPECT_LT(r.inliers, 0.25 * r.with_depth);  // anchored to the strip's last keyframes
+    } else {
+      EXPECT_GE(richer_alone, 1);
+      EXPECT_GE(r.inliers, 0.5 * r.with_depth);
+    }
+  }
+  EXPECT_GT(end_inliers[1], 2 * end_inliers[0]);
+}
+
 // The local map keeps a landmark while a keyframe in it observed the landmark, not only while
 // the keyframe that created it does. A still camera, a keyframe at every frame, a local map of
 // two keyframes: K0 sees the whole texture and creates its landmarks, K1 sees only the right
@@ -359,6 +408,13 @@ TEST(Odometry, BadFramesAndConfigsAreRefused) {
   c = OdometryConfig{};
   c.ba.every_keyframes = 0;
   EXPECT_NE(message(c).find("ba.every_keyframes = 0"), std::string::npos);
+  c = OdometryConfig{};
+  c.keyframe_richer_ratio = 0.9;
+  EXPECT_NE(message(c).find("keyframe_richer_ratio = 0.9"), std::string::npos);
+  c.keyframe_richer_ratio = 2.0;
+  c.keyframe_policy = KeyframePolicy::kOrbSlam2;
+  EXPECT_NE(message(c).find("keyframe_richer_ratio = 2: applies to keyframe_policy ratio only"), std::string::npos)
+      << message(c);
   EXPECT_THROW(RgbdOdometry(CameraIntrinsics{kW, kH, 0.0, kF, 0.0, 0.0}, OdometryConfig{}), std::invalid_argument);
 }
 
