@@ -12,10 +12,11 @@
 // those the last keyframe tracked and created, or the camera moved or turned far enough since
 // it, or (keyframe_richer_ratio r > 0) the frame has more than r times as many features with
 // depth as the last keyframe tracked and created: after a keyframe made in a near-blind view, a
-// view that offers far more than the map holds makes one (the inlier rule never fires there,
-// since the frame tracks more than the near-blind keyframe had). `orbslam2`: ORB-SLAM2's decision for an RGB-D camera
-// (Tracking::NeedNewKeyFrame): the frame tracks fewer than keyframe_reference_ratio (0.75; 0.4 while there is one
-// keyframe) of the reference keyframe's well-observed landmarks (observed twice or more: ORB-SLAM2 counts an
+// view that offers far more than the map holds makes one (the inlier rule need not fire there:
+// the frame may track more than the near-blind keyframe had). `orbslam2`: ORB-SLAM2's decision
+// for an RGB-D camera (Tracking::NeedNewKeyFrame): the frame tracks fewer than
+// keyframe_reference_ratio (0.75; 0.4 while there is one keyframe) of the reference keyframe's
+// well-observed landmarks (observed twice or more: ORB-SLAM2 counts an
 // observation with depth twice and wants 3 counts, 2 while there are at most two keyframes), or
 // it tracks fewer than 100 close landmarks (depth below keyframe_close_depth_m) while 70 close
 // features are unmatched; and it tracks more than 15; and either keyframe_max_frames frames
@@ -176,8 +177,8 @@ struct FrameResult {
   std::array<int, kColumnBins> inlier_columns{};
   bool keyframe = false;      // this frame became a keyframe
   std::string keyframe_rule;  // which rules asked for it, '+'-joined: "first" (initialisation);
-                              // ratio: "inliers", "translation", "rotation", "richer"; orbslam2: "reference",
-                              // "close"; empty for other frames
+                              // ratio: "inliers", "translation", "rotation", "richer"; orbslam2:
+                              // "reference", "close"; empty for other frames
   bool reinitialised = false;
   // For a frame where a bundle adjustment was applied (NaN otherwise; the keyframe itself with
   // ba.latency_frames 0, latency_frames later otherwise): how far BA moved and turned the
