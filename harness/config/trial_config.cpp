@@ -131,6 +131,10 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "guard_planned_turn = true: needs guard_tracking = true and guard_lead_s > 0 (it is what the lead foresees)");
   }
+  if (look_guard && !(look_then_fly && guard_lead_s > 0.0)) {
+    throw std::invalid_argument(
+        "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)");
+  }
   if (guard_still && !guard_tracking) {
     throw std::invalid_argument("guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   }

@@ -210,6 +210,17 @@ struct OnlineConfig {
   // counts only the landmarks mapped so far. false: look_min_detections as set (on detour-5006 the
   // vehicle never left its start, tracking 700-900 inliers, with no view rated above the floor).
   bool look_calibrate_floor = false;
+  // With look_then_fly and guard_lead_s > 0: while a look is flown, each tracked frame rates the
+  // view the trajectory holds guard_lead_s ahead, on the map of the latest plan, with the search's
+  // floor (the detections it asked of the look's views, LookPlan::floor). Where that view falls
+  // below the floor and the view now does not, the vehicle stops where its trajectory is (as the
+  // tracking guard does), the view ahead is ruled out for the looks as a trip without a turn
+  // (GuardEvent::predicted), and a plan is due. The search rates its grid's cells; the vehicle flies
+  // a smoothed path off them: on gallery seed 1 a look rated 213-220 at its cells flew views the
+  // model rated 76-118 on the same map, and the VO went from 1000 features to lost in 1 s without a
+  // turn, too fast for the guard's inliers (OnlinePlanning::lookGuard). false: looks are flown to
+  // their end unless the path is blocked or the tracking guard trips.
+  bool look_guard = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
@@ -300,6 +311,7 @@ struct OnlineConfig {
     a("look_stall_s", look_stall_s);
     a("look_keep_class", look_keep_class);
     a("look_calibrate_floor", look_calibrate_floor);
+    a("look_guard", look_guard);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);

@@ -59,6 +59,18 @@ RatedView worstView(const control::SetpointTrajectory& trajectory, double tau_fr
   return out;
 }
 
+std::optional<RatedView> viewAheadFallsShort(const control::SetpointTrajectory& trajectory, double tau_now,
+                                             double lead_s, double floor, const planner::VoxelMap& voxels,
+                                             const planner::VisibilityConfig& visibility,
+                                             const planner::InformationConfig& information) {
+  // worstView over no span: the one view, at the setpoints' place and yaw.
+  const auto rate = [&](double tau) { return worstView(trajectory, tau, 0.0, 1.0, voxels, visibility, information); };
+  const RatedView ahead = rate(tau_now + lead_s);
+  if (ahead.prediction.support.detections >= floor) return std::nullopt;
+  if (rate(tau_now).prediction.support.detections < floor) return std::nullopt;
+  return ahead;
+}
+
 const char* const kPredictionColumns =
     "predicted_score,predicted_landmarks,predicted_coverage,predicted_detections,predicted_near_detections,"
     "predicted_mean_range_m,predicted_column_span,predicted_row_span,predicted_inner_detections,"

@@ -2,6 +2,7 @@
 // What the planner's perception model predicts for the camera poses a trial really flew, for
 // calibrating the model against the VO (vo.csv's predicted_* columns beside the VO's own counts).
 #include <Eigen/Geometry>
+#include <optional>
 #include <ostream>
 #include <vector>
 
@@ -45,6 +46,14 @@ struct RatedView {
 RatedView worstView(const control::SetpointTrajectory& trajectory, double tau_from, double span_s, double step_s,
                     const planner::VoxelMap& voxels, const planner::VisibilityConfig& visibility,
                     const planner::InformationConfig& information);
+
+// trial.look_guard's check: the view `trajectory` holds lead_s after tau_now, where it expects
+// fewer than `floor` detections (planner::ViewSupport::detections) on `voxels` and the view at
+// tau_now does not; nothing where the view ahead meets the floor or the view now is below it already.
+std::optional<RatedView> viewAheadFallsShort(const control::SetpointTrajectory& trajectory, double tau_now,
+                                             double lead_s, double floor, const planner::VoxelMap& voxels,
+                                             const planner::VisibilityConfig& visibility,
+                                             const planner::InformationConfig& information);
 
 // vo.csv's columns of a prediction (`tgnav views` writes the same), and one frame's values in
 // them: comma-separated, no leading or trailing comma; the probability is empty without a model.

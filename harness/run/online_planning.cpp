@@ -323,6 +323,7 @@ LookPlan OnlinePlanning::searchLook(const planner::VoxelMap& voxels, const plann
 
 void OnlinePlanning::noteLook(const Attempt& a) {
   if (!a.look) return;
+  look_floor_ = a.record.look_floor;
   looked_.push_back(*a.look);
   if (cfg_.look_give_up > 0 && a.map) watch_.note(a.watched, a.map->resolution());
 }

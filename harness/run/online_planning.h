@@ -196,6 +196,7 @@ class OnlinePlanning {
   // The VO's result for a frame it tracked (flying on the estimate): its pose and inliers, and
   // where they lie across the image, for the tracking guard (trial.guard_tracking; view_guard.h). When it trips, the
   // vehicle holds where its trajectory is now, the camera turned back, and a plan is due ("blind_view").
+  // Before the guard, trial.look_guard rates the look's view ahead, and may stop the vehicle likewise.
   void trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame);
 
   // At simulated time t: replans when one is due. Returns why the flight must stop (no route and
@@ -242,8 +243,13 @@ class OnlinePlanning {
   LookPlan searchLook(const planner::VoxelMap& voxels, const planner::Pose4& start,
                       const std::vector<Eigen::Vector3d>& route, const std::vector<Eigen::Vector3d>& way_on,
                       bool all_observed, const LookMemory& memory, const LookConfig& look, OnlinePlan* record) const;
-  // An adopted plan's look pose: not chosen again, and its columns counted (watch_).
+  // An adopted plan's look pose: not chosen again, and its columns counted (watch_), and its floor.
   void noteLook(const Attempt& a);
+  // trial.look_guard at a tracked frame: true where it tripped (the vehicle holds, a plan is due).
+  bool lookGuard(double t_s, double trajectory_start_s);
+  // A guard's reflex at simulated time t_s: the trajectory spliced into a hold at `hold` from
+  // tau_now over 0.3 s, no look in flight, and a plan due at once ("blind_view").
+  void holdForView(const planner::Pose4& hold, double t_s, double tau_now);
   // The columns trial.look_give_up looks were to observe (their centres).
   std::vector<Eigen::Vector2d> givenUp() const;
   // trial.stop_before_unknown: a's path (and trajectory) end before they run into unknown space;
@@ -326,6 +332,10 @@ class OnlinePlanning {
   std::vector<planner::Pose4> looked_;       // trial.look_then_fly: the look poses flown to
   LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
+  // trial.look_guard: the latest plan's voxel map (from the first replan on), and the detections
+  // the look being flown asked of its views
+  std::unique_ptr<planner::VoxelMap> rated_map_;
+  double look_floor_ = 0.0;
   // trial.look_keep_class: the planner's route last adopted (2D)
   std::vector<Eigen::Vector2d> class_route_;
   OnlineResult result_;

@@ -25,6 +25,8 @@ constexpr double kSameRouteM = 0.75;
 // A flown plan's views are rated this often (OnlinePlan::flown_min_p): twice per camera frame
 // period at the default 20 Hz would double the cost for views 2.5 cm apart at the nominal speed.
 constexpr double kFlownViewStepS = 0.1;
+// The guards' reflex: a hold reached within this (a deceleration of about 1.3 m/s^2 at 0.4 m/s).
+constexpr double kGuardBlendS = 0.3;
 
 // Whether every pose of `path` lies within kSameRouteM (horizontally) of some point of `ahead`.
 bool followsRoute(const std::vector<planner::Pose4>& path, const std::vector<Eigen::Vector3d>& ahead) {
@@ -152,8 +154,50 @@ void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double ta
                    scenario_.planner.trajectory.max_yaw_rate_rad_s));
 }
 
+bool OnlinePlanning::lookGuard(double t_s, double trajectory_start_s) {
+  if (!cfg_.look_guard || !rated_map_ || t_s < trajectory_start_s) return false;
+  const double tau_now = tau(t_s, trajectory_start_s);
+  if (!lookInFlight(tau_now)) return false;
+  const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
+  // (A view below the floor already is not one the look flies into: the search starts where the
+  // vehicle is, whatever its view.)
+  const std::optional<RatedView> short_view = viewAheadFallsShort(
+      *current_, tau_now, cfg_.guard_lead_s, look_floor_, *rated_map_, perception.visibility, perception.information);
+  if (!short_view) return false;
+  const RatedView& ahead = *short_view;
+  const control::TrajectorySetpoint now = current_->sample(tau_now);
+  GuardEvent e;
+  e.t_s = t_s;
+  e.yaw_rad = ahead.yaw_rad;
+  e.good_yaw_rad = now.yaw_rad;
+  e.inliers = last_inliers_;
+  e.turning = false;  // the search rules out that view near the apex, at its yaw (trippedView)
+  e.predicted = true;
+  e.predicted_detections = ahead.prediction.support.detections;
+  const double half_fov = 0.5 * perception.visibility.hfov_rad;
+  e.wedge.apex = current_->sample(ahead.tau).p_WB;
+  e.wedge.from_rad = std::remainder(ahead.yaw_rad - half_fov, 2.0 * M_PI);
+  e.wedge.width_rad = 2.0 * half_fov;
+  e.wedge.range_m = cfg_.guard_range_m;
+  result_.guards.push_back(e);
+  // Not a wedge of unknown space planned occupied (wedges_): what makes the view poor is mapped.
+  holdForView(planner::Pose4{now.p_WB, now.yaw_rad}, t_s, tau_now);
+  return true;
+}
+
+void OnlinePlanning::holdForView(const planner::Pose4& hold, double t_s, double tau_now) {
+  // A reflex, not a plan: it stops within kGuardBlendS.
+  switchTo(holdTrajectory(hold, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_now, kGuardBlendS);
+  holding_ = true;
+  stops_short_ = false;
+  looking_ = false;
+  blind_view_ = true;
+  pending_until_s_ = t_s;
+}
+
 void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo::FrameResult& frame) {
   last_inliers_ = frame.inliers;
+  if (lookGuard(t_s, trajectory_start_s)) return;
   if (!guard_ || t_s < trajectory_start_s) return;
   const Eigen::Isometry3d& X_WC = frame.X_WC;
   const int inliers = frame.inliers;
@@ -173,15 +217,7 @@ void OnlinePlanning::trackFrame(double t_s, double trajectory_start_s, const vo:
   wedges_.push_back(*wedge);
   result_.guards.push_back(
       GuardEvent{t_s, yaw, good, inliers, guard_->lastTripTurned(), *wedge, guard_->lastTripPlannedRad()});
-  const planner::Pose4 hold{current_->sample(tau_now).p_WB, good};
-  // A reflex, not a plan: it stops within kGuardBlendS (a deceleration of about 1.3 m/s^2 at 0.4 m/s).
-  constexpr double kGuardBlendS = 0.3;
-  switchTo(holdTrajectory(hold, 2.0 * cfg_.replan_period_s + cfg_.plan_latency_s, holdRate()), tau_now, kGuardBlendS);
-  holding_ = true;
-  stops_short_ = false;
-  looking_ = false;
-  blind_view_ = true;
-  pending_until_s_ = t_s;
+  holdForView(planner::Pose4{current_->sample(tau_now).p_WB, good}, t_s, tau_now);
 }
 
 std::string OnlinePlanning::takeTrigger() {
@@ -205,6 +241,7 @@ void OnlinePlanning::adopt(Attempt* a, double tau_switch, double t_switch, bool 
   failed_in_a_row_ = 0;
   holding_ = false;
   if (guard_) guard_->rearm();
+  if (cfg_.look_guard) rated_map_ = std::move(a->run.voxels);
   result_.plans.push_back(std::move(a->record));
 }
 
@@ -262,6 +299,7 @@ std::string OnlinePlanning::replan(double t_s, double trajectory_start_s) {
       a.record.views_renewed = true;
       pending_until_s_ = t_eff;
     }
+    if (cfg_.look_guard) rated_map_ = std::move(a.run.voxels);
     result_.plans.push_back(std::move(a.record));
     return std::string();
   }

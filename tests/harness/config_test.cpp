@@ -439,6 +439,17 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_fov_margin_deg = -1.0;
   EXPECT_EQ(invalidArgument(t), "look_fov_margin_deg = -1: must be in [0, 45]");
   t = TrialConfig{};
+  t.online.look_guard = true;
+  const std::string look_guard_needs =
+      "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)";
+  EXPECT_EQ(invalidArgument(t), look_guard_needs);
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), look_guard_needs);  // no lead
+  t.online.guard_lead_s = 0.6;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_then_fly = false;
+  EXPECT_EQ(invalidArgument(t), look_guard_needs);
+  t = TrialConfig{};
   t.online.guard_still = true;
   EXPECT_EQ(invalidArgument(t), "guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   t.online.guard_tracking = true;

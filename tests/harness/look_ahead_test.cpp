@@ -263,6 +263,61 @@ TEST(WorstView, FindsTheLeastTrackableViewOfTheSpanAtTheModelsRating) {
   EXPECT_THROW(rate(0.0, -1.0), std::invalid_argument);
 }
 
+TEST(ViewAheadFallsShort, TripsWhileTheViewNowMeetsTheFloorAndTheViewAheadDoesNot) {
+  // trial.look_guard: the camera faces the textured wall (x = 3.5, landmarks for y in [-1.45, 1])
+  // from 1.75 m and slides north along it at 0.4 m/s, the texture leaving the image, without a turn.
+  WallViews wall;
+  const control::SetpointTrajectory slide = [] {
+    std::vector<double> t;
+    std::vector<control::TrajectorySetpoint> sp;
+    for (int i = 0; i <= 1000; ++i) {
+      t.push_back(i * 0.01);
+      control::TrajectorySetpoint s;
+      s.p_WB = Eigen::Vector3d(1.75, 0.4 * i * 0.01, 1.0);
+      s.v_WB.y() = 0.4;
+      sp.push_back(s);
+    }
+    return control::SetpointTrajectory(t, sp);
+  }();
+  const auto detections = [&](double tau) {
+    const control::TrajectorySetpoint sp = slide.sample(tau);
+    const Eigen::Vector3d p_WC = planner::cameraPosition(sp.p_WB, sp.yaw_rad, wall.visibility);
+    return predictFrame(wall.voxels, levelCamera(p_WC, sp.yaw_rad), wall.visibility, wall.information)
+        .support.detections;
+  };
+  const double floor = 0.5 * detections(0.0);
+  ASSERT_GT(floor, 10.0);
+  const double lead = 0.6;
+  double first_trip = -1.0;
+  double first_below = -1.0;  // the first view below the floor
+  for (double tau = 0.0; tau <= 9.0 + 1e-9; tau += 0.05) {
+    const bool below = detections(tau) < floor;
+    if (below && first_below < 0.0) first_below = tau;
+    const std::optional<RatedView> trip =
+        viewAheadFallsShort(slide, tau, lead, floor, wall.voxels, wall.visibility, wall.information);
+    if (below) {
+      EXPECT_FALSE(trip) << tau;  // flown into already
+      continue;
+    }
+    if (!trip) continue;
+    if (first_trip < 0.0) first_trip = tau;
+    EXPECT_NEAR(trip->tau, tau + lead, 1e-9);
+    EXPECT_LT(trip->prediction.support.detections, floor);
+    EXPECT_NEAR(trip->prediction.support.detections, detections(tau + lead), 1e-9);
+    // Without a lead the view ahead is the view now, which meets the floor.
+    EXPECT_FALSE(viewAheadFallsShort(slide, tau, 0.0, floor, wall.voxels, wall.visibility, wall.information));
+  }
+  std::cout << "[ figure   ] floor " << floor << ": trips from " << first_trip << " s, the view below it from "
+            << first_below << " s\n";
+  ASSERT_GT(first_trip, 0.0);
+  ASSERT_GT(first_below, first_trip);
+  EXPECT_LE(first_below - first_trip, lead + 0.05 + 1e-9);  // as soon as the lead reaches the bad view
+  // A floor the whole slide meets never trips.
+  for (double tau = 0.0; tau <= 9.0 + 1e-9; tau += 0.5) {
+    EXPECT_FALSE(viewAheadFallsShort(slide, tau, lead, 0.0, wall.voxels, wall.visibility, wall.information)) << tau;
+  }
+}
+
 TEST(StopBeforeUnknown, EndsBeforeThePathComesNearUnobservedSpaceAndLooksAtTheWayOn) {
   // A path along voxel centres east along y = 0.05 from x = 0.05 to 5.95, then north to y = 3.05;
   // observed free: a band y in [-0.3, 0.3) from x = 0.3 to 3.0, but for a hole at x in [1.4, 1.7).
