@@ -135,6 +135,9 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)");
   }
+  if (look_guard_routes && !look_guard) {
+    throw std::invalid_argument("look_guard_routes = true: needs look_guard = true (it widens what that guards)");
+  }
   if (guard_still && !guard_tracking) {
     throw std::invalid_argument("guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   }

@@ -219,8 +219,16 @@ struct OnlineConfig {
   // a smoothed path off them: on gallery seed 1 a look rated 213-220 at its cells flew views the
   // model rated 76-118 on the same map, and the VO went from 1000 features to lost in 1 s without a
   // turn, too fast for the guard's inliers (OnlinePlanning::lookGuard). false: looks are flown to
-  // their end unless the path is blocked or the tracking guard trips.
+  // their end unless the path is blocked or the tracking guard trips. Measured on development scenes,
+  // not adopted: gallery still 0/2, detour 5001-5008 6/8 against 5/8 (docs/results/look_guard).
   bool look_guard = false;
+  // With look_guard: every trajectory flown is guarded, not only looks: the search's way to the goal
+  // and the route flown as planned (look_fallback, look_stall_s), at look_min_detections where no
+  // look's floor applies. On gallery seed 1 with look_guard the flight ended after two look_fallback
+  // plans flew the route with the look-ahead's views, unrated, and the VO went from 1000 features to
+  // lost in 5 s. With it, both gallery flights kept the VO and timed out 21 m from the goal: the
+  // fallback tripped, held, and flew the same route again (docs/results/look_guard). false: looks only.
+  bool look_guard_routes = false;
   // A plan along the current route (not flown: a switch restarts from rest) renews the views
   // ahead: the trajectory keeps its positions and takes the new plan's yaw, planned on the map as
   // it is now, from the vehicle's yaw at the switch, then the look-ahead rule on that map
@@ -312,6 +320,7 @@ struct OnlineConfig {
     a("look_keep_class", look_keep_class);
     a("look_calibrate_floor", look_calibrate_floor);
     a("look_guard", look_guard);
+    a("look_guard_routes", look_guard_routes);
     a("renew_views", renew_views);
     a("guard_tracking", guard_tracking);
     a("guard_inliers", guard_inliers);

@@ -157,12 +157,14 @@ void OnlinePlanning::switchTo(const control::SetpointTrajectory& next, double ta
 bool OnlinePlanning::lookGuard(double t_s, double trajectory_start_s) {
   if (!cfg_.look_guard || !rated_map_ || t_s < trajectory_start_s) return false;
   const double tau_now = tau(t_s, trajectory_start_s);
-  if (!lookInFlight(tau_now)) return false;
+  const bool look = lookInFlight(tau_now);
+  if (!look && !cfg_.look_guard_routes) return false;
+  const double floor = look ? look_floor_ : cfg_.look_min_detections;
   const planner::PerceptionPlannerConfig& perception = scenario_.planner.perception;
   // (A view below the floor already is not one the look flies into: the search starts where the
   // vehicle is, whatever its view.)
   const std::optional<RatedView> short_view = viewAheadFallsShort(
-      *current_, tau_now, cfg_.guard_lead_s, look_floor_, *rated_map_, perception.visibility, perception.information);
+      *current_, tau_now, cfg_.guard_lead_s, floor, *rated_map_, perception.visibility, perception.information);
   if (!short_view) return false;
   const RatedView& ahead = *short_view;
   const control::TrajectorySetpoint now = current_->sample(tau_now);

@@ -450,6 +450,9 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_then_fly = false;
   EXPECT_EQ(invalidArgument(t), look_guard_needs);
   t = TrialConfig{};
+  t.online.look_guard_routes = true;
+  EXPECT_EQ(invalidArgument(t), "look_guard_routes = true: needs look_guard = true (it widens what that guards)");
+  t = TrialConfig{};
   t.online.guard_still = true;
   EXPECT_EQ(invalidArgument(t), "guard_still = true: needs guard_tracking = true (it is how the guard trips)");
   t.online.guard_tracking = true;
