@@ -332,8 +332,8 @@ class OnlinePlanning {
   std::vector<planner::Pose4> looked_;       // trial.look_then_fly: the look poses flown to
   LookWatch watch_;       // ... the looks adopted per unknown column they were to observe (trial.look_give_up)
   int last_inliers_ = 0;  // the VO's inliers in the last frame it tracked
-  // trial.look_guard: the latest plan's voxel map (from the first replan on), and the detections
-  // the look being flown asked of its views
+  // trial.look_guard: the voxel map of the latest plan flown or recorded along the route (from the
+  // first replan on; not of a plan that failed), and the detections the look being flown asked of its views
   std::unique_ptr<planner::VoxelMap> rated_map_;
   double look_floor_ = 0.0;
   // trial.look_keep_class: the planner's route last adopted (2D)

@@ -174,7 +174,6 @@ bool OnlinePlanning::lookGuard(double t_s, double trajectory_start_s) {
   e.good_yaw_rad = now.yaw_rad;
   e.inliers = last_inliers_;
   e.turning = false;  // the search rules out that view near the apex, at its yaw (trippedView)
-  e.predicted = true;
   e.predicted_detections = ahead.prediction.support.detections;
   const double half_fov = 0.5 * perception.visibility.hfov_rad;
   e.wedge.apex = current_->sample(ahead.tau).p_WB;

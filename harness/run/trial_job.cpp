@@ -260,7 +260,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
                       {"inliers", g.inliers},
                       {"turning", g.turning},
                       {"planned_rad", g.planned_rad},
-                      {"predicted", g.predicted},
+                      {"predicted", g.predicted()},
                       {"predicted_detections", g.predicted_detections},
                       {"wedge_from_rad", g.wedge.from_rad},
                       {"wedge_width_rad", g.wedge.width_rad},

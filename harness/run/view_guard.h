@@ -52,11 +52,11 @@ struct GuardEvent {
   // The commanded turn the lead foresaw and tripped on (trial.guard_planned_turn), else 0: the turn
   // toward the bad view is then yaw_rad - good_yaw_rad plus this.
   double planned_rad = 0.0;
-  // trial.look_guard tripped it, not the inliers: the view the look would fly guard_lead_s ahead,
-  // rated below the look's floor (these detections) on the latest plan's map. Its wedge's apex is the
-  // body's place there, yaw_rad that view's yaw, good_yaw_rad the yaw held; turning is false.
-  bool predicted = false;
+  // >= 0 where trial.look_guard tripped it, not the inliers: the detections the view the look would
+  // fly guard_lead_s ahead expects on the latest plan's map, below the look's floor. Its wedge's apex
+  // is then the body's place there, yaw_rad that view's yaw, good_yaw_rad the yaw held; turning is false.
   double predicted_detections = -1.0;
+  bool predicted() const { return predicted_detections >= 0.0; }
 };
 
 // Whether the guard's trip `event` rules out the view from p along yaw: within within_m of where it
