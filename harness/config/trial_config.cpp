@@ -122,6 +122,12 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_fov_margin_deg > 0: needs look_then_fly = true (it narrows the views the explorer rates)");
   }
+  require(std::isfinite(look_hold_margin) && look_hold_margin >= 0.0 && look_hold_margin <= 10.0, "look_hold_margin",
+          look_hold_margin, "must be in [0, 10]");
+  if (look_hold_margin > 0.0 && !look_then_fly) {
+    throw std::invalid_argument(
+        "look_hold_margin > 0: needs look_then_fly = true (it is asked of the views the explorer stops at)");
+  }
   require(guard_inliers >= 1 && guard_inliers <= 10000, "guard_inliers", guard_inliers, "must be in [1, 10000]");
   require(std::isfinite(guard_range_m) && guard_range_m > 0.0 && guard_range_m <= 100.0, "guard_range_m", guard_range_m,
           "must be in (0, 100]");

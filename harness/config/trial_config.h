@@ -161,6 +161,12 @@ struct OnlineConfig {
   // (OnlinePlanning::searchLook). 0: the whole image. Measured at 7.5 deg, half the search's yaw step
   // (chosen before any run, not fitted), and left off (docs/results/fov_margin).
   double look_fov_margin_deg = 0.0;
+  // With look_then_fly: the view a look (or an advance) ends at, where the vehicle stops and holds
+  // it while the next plan is made, must expect this much more than the search's floor (detections
+  // >= floor x (1 + margin); LookConfig::hold_margin), the views on the way there the floor. On
+  // gallery seed 2 (look_guard) a look ended at a view its search rated 157 against 150; on the
+  // map 14 s later it rated 142, and the VO was lost there. 0: the floor.
+  double look_hold_margin = 0.0;
   // With look_then_fly, a goal-directed order of looks (LookConfig::advance): a look must observe
   // the robot's footprint of unknown space; where none observes the way on, the vehicle flies along
   // the route's observed part as far as the search reaches, and only then looks near the way on, then
@@ -312,6 +318,7 @@ struct OnlineConfig {
     a("look_then_fly", look_then_fly);
     a("look_min_detections", look_min_detections);
     a("look_fov_margin_deg", look_fov_margin_deg);
+    a("look_hold_margin", look_hold_margin);
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);

@@ -35,6 +35,12 @@ struct CellSight {
 // LookSearch's on_way_).
 enum class Tier : std::uint8_t { kAny = 0, kNear = 1, kWay = 2 };
 
+// A view from a cell (LookSearch::ratings).
+struct Rated {
+  float shortfall;
+  float detections;
+};
+
 // The search of planLook() over (cell, yaw) states: state = cell * yaws + yaw index.
 class LookSearch {
  public:
@@ -53,7 +59,7 @@ class LookSearch {
     step_ = 2.0 * M_PI / yaws_;
     const std::size_t cells = static_cast<std::size_t>(gx_) * gy_;
     clear_.assign(cells, -1);
-    shortfall_.resize(cells);
+    rated_.resize(cells);
     sight_.resize(cells);
     stamp_.assign(static_cast<std::size_t>(columns_.nx()) * columns_.ny(), -1);
     const Eigen::Vector2d s = start.p_WB.head<2>();
@@ -125,7 +131,7 @@ class LookSearch {
     std::vector<int> first(static_cast<std::size_t>(gx_) * gy_, -1);  // per cell
     for (const int s : settled_) {
       int& f = first[at(s / yaws_)];
-      if (f >= 0 || s / yaws_ == start_cell_) continue;
+      if (f >= 0 || s / yaws_ == start_cell_ || !holds(s)) continue;
       const Eigen::Vector2d p = place(s / yaws_);
       const bool flown = std::any_of(looked.begin(), looked.end(), [&](const planner::Pose4& l) {
         return (l.p_WB.head<2>() - p).norm() <= config_.repeat_m;
@@ -159,7 +165,8 @@ class LookSearch {
     int best = 0;
     for (std::size_t n = 0; n < settled_.size(); ++n) {
       const int s = settled_[n];
-      if (s == start_state_ || repeats(s, looked)) continue;  // the view it has now, or one flown to
+      // The view it has now, one flown to, or one too poor to hold (LookConfig::hold_margin).
+      if (s == start_state_ || repeats(s, looked) || !holds(s)) continue;
       const CellSight& cs = sight(s / yaws_);
       seen[n] = seenAlong(tier == Tier::kWay ? cs.way : tier == Tier::kNear ? cs.near : cs.any, yawOf(s % yaws_));
       best = std::max(best, seen[n]);
@@ -193,15 +200,15 @@ class LookSearch {
       const int cell = s / yaws_;
       if (asked[at(cell)]) continue;
       asked[at(cell)] = 1;
-      const std::vector<float>& short_by = shortfalls(cell);
+      const std::vector<Rated>& rated = ratings(cell);
       const CellSight& cs = sight(cell);
       for (int k = 0; k < yaws_; ++k) {
         const int view = cell * yaws_ + k;
-        if (short_by[at(k)] >= least || view == start_state_ || repeats(view, looked)) continue;
+        if (rated[at(k)].shortfall >= least || view == start_state_ || repeats(view, looked)) continue;
         const int seen = seenAlong(cs.way, yawOf(k));
         if (seen < min_seen) continue;
         chosen = view;
-        least = short_by[at(k)];
+        least = rated[at(k)].shortfall;
         *from = s;
         out->seen = seen;
       }
@@ -226,18 +233,12 @@ class LookSearch {
     const int half = static_cast<int>(std::floor(config_.half_hfov_rad / kRayStepRad));
     const int mid = static_cast<int>(std::lround(yawOf(state % yaws_) / kRayStepRad));
     const auto needed = static_cast<std::uint8_t>(tier);
-    const double dr = 0.5 * columns_.res();
     std::vector<std::size_t> columns;
     for (int r = mid - half; r <= mid + half; ++r) {
       const double a = ((r % rays + rays) % rays) * kRayStepRad;
-      const Eigen::Vector2d dir(std::cos(a), std::sin(a));
-      for (double d = dr; d <= config_.observe_range_m; d += dr) {
-        const auto [i, j] = columns_.cellOf(from + d * dir);
-        if (!columns_.inside(i, j)) break;
-        const std::size_t c = columns_.index(i, j);
-        if (columns_.occupied(c)) break;
+      columns_.march(from, Eigen::Vector2d(std::cos(a), std::sin(a)), config_.observe_range_m, [&](std::size_t c) {
         if (columns_.toObserve(c) && on_way_[c] >= needed) columns.push_back(c);
-      }
+      });
     }
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
@@ -341,23 +342,31 @@ class LookSearch {
   }
 
   // Per yaw, how far the view from the cell falls short of trackable (ViewRater::shortfall; 0:
-  // trackable), kRuledOut where the guard tripped on it.
-  const std::vector<float>& shortfalls(int cell) {
-    std::vector<float>& short_by = shortfall_[at(cell)];
-    if (!short_by.empty()) return short_by;
+  // trackable), kRuledOut where the guard tripped on it, and the detections it expects.
+  const std::vector<Rated>& ratings(int cell) {
+    std::vector<Rated>& rated = rated_[at(cell)];
+    if (!rated.empty()) return rated;
     const Eigen::Vector2d c = place(cell);
     rateFrom(c);
-    short_by.resize(at(yaws_));
+    rated.resize(at(yaws_));
     for (int k = 0; k < yaws_; ++k) {
       const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
         return trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
       });
-      short_by[at(k)] = ruled_out ? kRuledOut : static_cast<float>(rater_.shortfall(yawOf(k)));
+      const ViewRating r = rater_.rate(yawOf(k));
+      rated[at(k)] = {ruled_out ? kRuledOut : static_cast<float>(r.shortfall), static_cast<float>(r.detections)};
     }
     ++cells_rated_;
-    return short_by;
+    return rated;
   }
-  bool trackable(int cell, int k) { return shortfalls(cell)[at(k)] <= 0.0F; }
+  bool trackable(int cell, int k) { return ratings(cell)[at(k)].shortfall <= 0.0F; }
+  // A settled state's view is one to stop and hold (LookConfig::hold_margin); every state settled
+  // but the start was rated trackable on the way to it, so its cell's views are rated.
+  bool holds(int state) const {
+    const std::vector<Rated>& rated = rated_[at(state / yaws_)];
+    return config_.hold_margin <= 0.0 || (!rated.empty() && rated[at(state % yaws_)].detections >=
+                                                                rater_.detectionFloor() * (1.0 + config_.hold_margin));
+  }
 
   // What the cell's views observe: rays kRayStepRad apart to config.observe_range_m, through
   // unknown columns (optimistic), stopping at occupied ones.
@@ -369,20 +378,15 @@ class LookSearch {
     s.near.assign(at(rays), 0);
     s.any.assign(at(rays), 0);
     const Eigen::Vector2d from = place(cell);
-    const double dr = 0.5 * columns_.res();
     for (int r = 0; r < rays; ++r) {
       const Eigen::Vector2d dir(std::cos(r * kRayStepRad), std::sin(r * kRayStepRad));
-      for (double d = dr; d <= config_.observe_range_m; d += dr) {
-        const auto [i, j] = columns_.cellOf(from + d * dir);
-        if (!columns_.inside(i, j)) break;
-        const std::size_t c = columns_.index(i, j);
-        if (columns_.occupied(c)) break;
-        if (!columns_.toObserve(c) || stamp_[c] == cell) continue;
+      columns_.march(from, dir, config_.observe_range_m, [&](std::size_t c) {
+        if (!columns_.toObserve(c) || stamp_[c] == cell) return;
         stamp_[c] = cell;
         ++s.any[at(r)];
         if (on_way_[c] >= static_cast<std::uint8_t>(Tier::kNear)) ++s.near[at(r)];
         if (on_way_[c] == static_cast<std::uint8_t>(Tier::kWay)) ++s.way[at(r)];
-      }
+      });
     }
     return s;
   }
@@ -425,14 +429,14 @@ class LookSearch {
   double step_ = 2.0 * M_PI;
   int start_cell_ = 0;
   int start_state_ = 0;
-  std::vector<std::int8_t> clear_;             // per cell: -1 not asked yet
-  std::vector<std::vector<float>> shortfall_;  // per cell, per yaw: shortfalls() (empty: not rated yet)
-  std::vector<CellSight> sight_;               // per cell (empty: not cast yet)
-  std::vector<int> stamp_;                     // per column: the cell whose rays reached it last
-  std::vector<std::uint8_t> on_way_;           // per column: its Tier (kAny: neither near nor on)
-  std::vector<double> cost_;                   // per state
-  std::vector<int> prev_;                      // per state
-  std::vector<int> settled_;                   // in order of cost
+  std::vector<std::int8_t> clear_;         // per cell: -1 not asked yet
+  std::vector<std::vector<Rated>> rated_;  // per cell, per yaw: ratings() (empty: not rated yet)
+  std::vector<CellSight> sight_;           // per cell (empty: not cast yet)
+  std::vector<int> stamp_;                 // per column: the cell whose rays reached it last
+  std::vector<std::uint8_t> on_way_;       // per column: its Tier (kAny: neither near nor on)
+  std::vector<double> cost_;               // per state
+  std::vector<int> prev_;                  // per state
+  std::vector<int> settled_;               // in order of cost
   int cells_rated_ = 0;
 };
 

@@ -72,6 +72,10 @@ struct LookConfig {
   // is lower (never raised). 0: the floor as set.
   int tracked_inliers = 0;
   int floor_inliers = 150;
+  // trial.look_hold_margin: a look pose, or an advance's end, where the vehicle stops and holds
+  // its view while the next plan is made, must expect at least the floor in force times (1 +
+  // hold_margin) detections; the views on the way there, the floor. 0: the floor.
+  double hold_margin = 0.0;
 };
 
 struct LookPlan {

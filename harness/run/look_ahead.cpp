@@ -26,21 +26,22 @@ void ViewRater::moveTo(const Eigen::Vector3d& p_WB, const std::function<bool(con
   points_ = planner::aggregateSlots(*voxels_, voxels_->visibleSlots(p_WB, *visibility_, keep));
 }
 
-double ViewRater::shortfall(double yaw_rad) const {
+ViewRating ViewRater::rate(double yaw_rad) const {
   planner::ViewSupport support;
   planner::poseInformation(planner::cameraPosition(p_WB_, yaw_rad, *visibility_), yaw_rad, points_, *visibility_,
                            *information_, &support);
-  const double gates = planner::gateShortfall(support, *information_);
-  if (support.detections >= detection_floor_) return gates;
-  return std::max(gates, 1.0 - support.detections / detection_floor_);
+  ViewRating r;
+  r.detections = support.detections;
+  r.shortfall = planner::gateShortfall(support, *information_);
+  if (support.detections < detection_floor_) {
+    r.shortfall = std::max(r.shortfall, 1.0 - support.detections / detection_floor_);
+  }
+  return r;
 }
 
-double ViewRater::detections(double yaw_rad) const {
-  planner::ViewSupport support;
-  planner::poseInformation(planner::cameraPosition(p_WB_, yaw_rad, *visibility_), yaw_rad, points_, *visibility_,
-                           *information_, &support);
-  return support.detections;
-}
+double ViewRater::shortfall(double yaw_rad) const { return rate(yaw_rad).shortfall; }
+
+double ViewRater::detections(double yaw_rad) const { return rate(yaw_rad).detections; }
 
 double trackableShare(const ViewRater& rater, double planned, double look, double near, double near_limit) {
   const double turn = std::remainder(look - planned, 2.0 * M_PI);

@@ -16,6 +16,12 @@
 
 namespace tgnav::harness {
 
+// A view as ViewRater rates it.
+struct ViewRating {
+  double shortfall = 0.0;   // ViewRater::shortfall
+  double detections = 0.0;  // ViewRater::detections
+};
+
 // Smooths the yaws of `sp` (at times `t`, evenly spaced) over a moving 1 s window on the unit
 // circle, then holds the yaw rate within `max_rate` (a backward pass, so that a turn starts early
 // enough, then a forward pass from the first setpoint's own yaw, which stays as it was: a
@@ -45,6 +51,8 @@ class ViewRater {
   double detectionFloor() const { return detection_floor_; }
   // The detections the model expects of the view along yaw_rad (planner::ViewSupport::detections).
   double detections(double yaw_rad) const;
+  // Both at once (one evaluation of the model).
+  ViewRating rate(double yaw_rad) const;
 
  private:
   const planner::VoxelMap* voxels_;

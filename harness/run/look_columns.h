@@ -79,6 +79,17 @@ class LookColumns {
     }
     return true;
   }
+  // Calls visit(column index) for the columns a ray from p along the unit vector dir reaches within
+  // range_m, in steps of half a column, up to the first occupied one (not visited) or the map's edge.
+  template <typename Visit>
+  void march(const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double range_m, Visit visit) const {
+    const double dr = 0.5 * res_;
+    for (double d = dr; d <= range_m; d += dr) {
+      const auto [i, j] = cellOf(p + d * dir);
+      if (!inside(i, j) || occupied(index(i, j))) return;
+      visit(index(i, j));
+    }
+  }
   // No column within `radius` of p occupied, and every one within `known_m` of it observed.
   bool clear(const Eigen::Vector2d& p, double radius, double known_m) const {
     const int reach = static_cast<int>(std::ceil(std::max(radius, known_m) / res_)) + 1;

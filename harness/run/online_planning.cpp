@@ -243,11 +243,11 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
   look.observe_range_m = cfg_.map_range_m;
   look.turn_m_per_rad =
       scenario_.planner.trajectory.nominal_speed_mps / scenario_.planner.trajectory.nominal_yaw_rate_rad_s;
-  look.visited_clear_m = clear_m;
-  look.way_clear_m = clear_m;
+  look.visited_clear_m = look.way_clear_m = clear_m;
   look.advance = cfg_.look_advance;
   look.probe = cfg_.look_probe;
   look.floor_inliers = cfg_.guard_inliers;
+  look.hold_margin = cfg_.look_hold_margin;
   if (cfg_.look_calibrate_floor && last_inliers_ >= cfg_.guard_inliers) look.tracked_inliers = last_inliers_;
   const LookMemory memory{visited_, looked_, givenUp(), result_.guards};
   const LookPlan found =

@@ -439,6 +439,14 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_fov_margin_deg = -1.0;
   EXPECT_EQ(invalidArgument(t), "look_fov_margin_deg = -1: must be in [0, 45]");
   t = TrialConfig{};
+  t.online.look_hold_margin = 0.2;
+  EXPECT_EQ(invalidArgument(t),
+            "look_hold_margin > 0: needs look_then_fly = true (it is asked of the views the explorer stops at)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_hold_margin = std::nan("");
+  EXPECT_EQ(invalidArgument(t), "look_hold_margin = nan: must be in [0, 10]");
+  t = TrialConfig{};
   t.online.look_guard = true;
   const std::string look_guard_needs =
       "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)";

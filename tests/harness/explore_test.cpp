@@ -330,6 +330,42 @@ TEST(LookThenFly, TheFloorCalibratedOnTheTrackedViewLetsItMove) {
             << " reaches the goal\n";
 }
 
+// LookConfig::hold_margin: the view a look stops at expects the floor times (1 + margin); the
+// views on the way there, the floor.
+TEST(LookThenFly, TheViewALookStopsAtExpectsTheHoldMarginOverTheFloor) {
+  Room room(3.4);
+  room.rater.moveTo(kStart.p_WB);
+  const double floor = 0.3 * room.rater.detections(kStart.yaw_rad);
+  room.rater.setDetectionFloor(floor);
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {}};
+  const auto endView = [&](const LookPlan& plan) {
+    room.rater.moveTo(plan.path.back().p_WB);
+    return room.rater.detections(plan.path.back().yaw_rad);
+  };
+  const LookPlan plain = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(), memory, config());
+  ASSERT_GE(plain.path.size(), 2U);
+  const double plain_end = endView(plain);
+  // A margin the plain look's end view falls short of by one detection: another view is held.
+  LookConfig c = config();
+  c.hold_margin = (plain_end + 1.0) / floor - 1.0;
+  const LookPlan held = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(), memory, c);
+  ASSERT_GE(held.path.size(), 2U);
+  EXPECT_TRUE(held.way);
+  EXPECT_GE(endView(held), plain_end + 1.0);
+  for (const planner::Pose4& p : held.path) {
+    room.rater.moveTo(p.p_WB);
+    EXPECT_EQ(room.rater.shortfall(p.yaw_rad), 0.0) << p.p_WB.transpose() << " yaw " << p.yaw_rad;
+  }
+  // A margin no view reaches: no look, where the search still moves (the floor alone).
+  c.hold_margin = 10.0;
+  const LookPlan none = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(), memory, c);
+  EXPECT_TRUE(none.path.empty());
+  EXPECT_GT(none.states, 1);
+  std::cout << "[ figure   ] floor " << floor << ": the plain look ends at a view expecting " << plain_end
+            << " detections, with the margin " << endView(held) << " (cost " << plain.cost_m << " -> " << held.cost_m
+            << " m)\n";
+}
+
 TEST(LookThenFly, FindsNothingWhereNoViewIsTrackable) {
   Room bare(3.4, false);
   const Eigen::Vector3d goal(2.5, 3.5, kHeight);
