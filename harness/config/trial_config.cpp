@@ -80,18 +80,7 @@ void ImuConfig::validate() const {
   nonNegative(gyro_bias_rad_s, "gyro_bias_rad_s");
 }
 
-void OnlineConfig::validate() const {
-  require(std::isfinite(prior_radius_m) && prior_radius_m > 0.0, "prior_radius_m", prior_radius_m, "must be > 0");
-  require(std::isfinite(plan_latency_s) && plan_latency_s >= 0.0 && plan_latency_s <= 10.0, "plan_latency_s",
-          plan_latency_s, "must be in [0, 10]");
-  require(std::isfinite(replan_period_s) && replan_period_s > plan_latency_s && replan_period_s <= 60.0,
-          "replan_period_s", replan_period_s, "must be > plan_latency_s and <= 60");
-  require(std::isfinite(blend_s) && blend_s >= 0.0 && blend_s <= 10.0, "blend_s", blend_s, "must be in [0, 10]");
-  require(std::isfinite(commit_s) && commit_s >= 0.0 && commit_s <= 60.0, "commit_s", commit_s, "must be in [0, 60]");
-  require(std::isfinite(route_margin) && route_margin >= 0.0 && route_margin <= 10.0, "route_margin", route_margin,
-          "must be in [0, 10]");
-  require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
-          "must be in [0, 10]");
+void OnlineConfig::validateLooks() const {
   if (look_ahead_best_view && look_ahead_keeps_tracking) {
     throw std::invalid_argument(
         "look_ahead_best_view = true: not with look_ahead_keeps_tracking = true (two rules for the same yaw)");
@@ -122,12 +111,35 @@ void OnlineConfig::validate() const {
     throw std::invalid_argument(
         "look_fov_margin_deg > 0: needs look_then_fly = true (it narrows the views the explorer rates)");
   }
+  require(std::isfinite(look_fallback_floor) && look_fallback_floor >= 0.0 && look_fallback_floor <= 10000.0,
+          "look_fallback_floor", look_fallback_floor, "must be in [0, 10000]");
+  if (look_fallback_floor > 0.0 && !look_fallback) {
+    throw std::invalid_argument(
+        "look_fallback_floor > 0: needs look_fallback = true (the search is made again before the fallback)");
+  }
+  require(look_fallback_floor < look_min_detections || look_fallback_floor <= 0.0, "look_fallback_floor",
+          look_fallback_floor, "must be below look_min_detections");
   require(std::isfinite(look_hold_margin) && look_hold_margin >= 0.0 && look_hold_margin <= 10.0, "look_hold_margin",
           look_hold_margin, "must be in [0, 10]");
   if (look_hold_margin > 0.0 && !look_then_fly) {
     throw std::invalid_argument(
         "look_hold_margin > 0: needs look_then_fly = true (it is asked of the views the explorer stops at)");
   }
+}
+
+void OnlineConfig::validate() const {
+  require(std::isfinite(prior_radius_m) && prior_radius_m > 0.0, "prior_radius_m", prior_radius_m, "must be > 0");
+  require(std::isfinite(plan_latency_s) && plan_latency_s >= 0.0 && plan_latency_s <= 10.0, "plan_latency_s",
+          plan_latency_s, "must be in [0, 10]");
+  require(std::isfinite(replan_period_s) && replan_period_s > plan_latency_s && replan_period_s <= 60.0,
+          "replan_period_s", replan_period_s, "must be > plan_latency_s and <= 60");
+  require(std::isfinite(blend_s) && blend_s >= 0.0 && blend_s <= 10.0, "blend_s", blend_s, "must be in [0, 10]");
+  require(std::isfinite(commit_s) && commit_s >= 0.0 && commit_s <= 60.0, "commit_s", commit_s, "must be in [0, 60]");
+  require(std::isfinite(route_margin) && route_margin >= 0.0 && route_margin <= 10.0, "route_margin", route_margin,
+          "must be in [0, 10]");
+  require(std::isfinite(look_ahead_s) && look_ahead_s >= 0.0 && look_ahead_s <= 10.0, "look_ahead_s", look_ahead_s,
+          "must be in [0, 10]");
+  validateLooks();
   require(guard_inliers >= 1 && guard_inliers <= 10000, "guard_inliers", guard_inliers, "must be in [1, 10000]");
   require(std::isfinite(guard_range_m) && guard_range_m > 0.0 && guard_range_m <= 100.0, "guard_range_m", guard_range_m,
           "must be in (0, 100]");

@@ -192,6 +192,12 @@ struct OnlineConfig {
   // guard). Not before: at the start, with nothing mapped, flying the route lost the VO at once where
   // holding and looking went on to the goal (development scene detour-5004).
   bool look_fallback = false;
+  // With look_fallback, > 0: before the route is flown as planned, with views nothing rated, the
+  // search is made again with this detection floor in place of look_min_detections, and a look (or
+  // the way to the goal) it finds is flown instead (online.json: look_lowered). The fallbacks'
+  // routes flew views the model rated 76-118 on the map they were planned on, and came just before
+  // 2 of the 3 VO losses of docs/results/hold_margin. 0: the route at once.
+  double look_fallback_floor = 0.0;
   // With look_then_fly, > 0: where no plan for this long (simulated seconds) has found a route to the
   // goal at least 0.5 m shorter than the shortest before it (RouteProgress), the looks have stalled,
   // and the plan flies the planner's route instead, as look_fallback does. On development scene
@@ -323,6 +329,7 @@ struct OnlineConfig {
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);
     a("look_fallback", look_fallback);
+    a("look_fallback_floor", look_fallback_floor);
     a("look_stall_s", look_stall_s);
     a("look_keep_class", look_keep_class);
     a("look_calibrate_floor", look_calibrate_floor);
@@ -348,6 +355,7 @@ struct OnlineConfig {
   // takes only the map resolution, the survey's default).
   bool needsSurvey() const { return !online() || prior_map != PriorMap::kNone; }
   void validate() const;
+  void validateLooks() const;  // validate()'s checks of the look_* keys
 };
 
 struct TrialConfig {

@@ -90,8 +90,12 @@ struct OnlinePlan {
   bool look_probe = false;     // ... it turned to a view of the way on the model rates short (LookPlan::probe)
   bool look_fallback = false;  // trial.look_fallback: no look was left, and the route was flown as planned
                                // (where this failure would have ended the trial)
-  bool look_stall = false;     // trial.look_stall_s: the looks had stalled, and the route was flown as planned
-  double look_floor = -1.0;    // ... the detection floor its views were rated with (LookPlan::floor)
+  // trial.look_fallback_floor: no look was left at look_min_detections where this failure would end
+  // the trial, and the search was made again at the lower floor (look_floor: the floor it found
+  // the look at; look_fallback: it found none there either)
+  bool look_lowered = false;
+  bool look_stall = false;   // trial.look_stall_s: the looks had stalled, and the route was flown as planned
+  double look_floor = -1.0;  // ... the detection floor its views were rated with (LookPlan::floor)
   // ... trial.look_fov_margin_deg: the search with the margin found nothing to fly, and this one was
   // rated on the whole image (OnlinePlanning::searchLook)
   bool look_whole_fov = false;
@@ -237,12 +241,15 @@ class OnlinePlanning {
   // its path becomes the way to the look pose (explore.h), or, where no view observes any unknown
   // space (or that way cannot be flown), it fails (a->record.ok false): the vehicle holds.
   bool lookFirst(const Scenario& from_here, const planner::FeatureMap& map, double clear_m, Attempt* a);
-  // planLook from `start` on `voxels` with the views rated as trial.look_fov_margin_deg and
-  // look_min_detections say (the margin dropped where it leaves nothing to fly); record's look_path
-  // and look_whole_fov say what it rated.
+  // The look search's settings for a plan from from_here's start (clear_m: stopBeforeUnknown's).
+  LookConfig lookConfig(const Scenario& from_here, double clear_m) const;
+  // planLook from `start` on `voxels` with the views rated as trial.look_fov_margin_deg says (the
+  // margin dropped where it leaves nothing to fly), at the detection floor min_detections (0: none);
+  // record's look_path and look_whole_fov say what it rated.
   LookPlan searchLook(const planner::VoxelMap& voxels, const planner::Pose4& start,
                       const std::vector<Eigen::Vector3d>& route, const std::vector<Eigen::Vector3d>& way_on,
-                      bool all_observed, const LookMemory& memory, const LookConfig& look, OnlinePlan* record) const;
+                      bool all_observed, const LookMemory& memory, const LookConfig& look, double min_detections,
+                      OnlinePlan* record) const;
   // An adopted plan's look pose: not chosen again, and its columns counted (watch_), and its floor.
   void noteLook(const Attempt& a);
   // trial.look_guard at a tracked frame: true where it tripped (the vehicle holds, a plan is due).

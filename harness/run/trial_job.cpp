@@ -224,6 +224,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["look_advance"] = p.look_advance;
     j["look_probe"] = p.look_probe;
     j["look_fallback"] = p.look_fallback;
+    j["look_lowered"] = p.look_lowered;
     j["look_stall"] = p.look_stall;
     j["look_near"] = p.look_near;
     j["look_floor"] = p.look_floor;

@@ -439,6 +439,15 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_fov_margin_deg = -1.0;
   EXPECT_EQ(invalidArgument(t), "look_fov_margin_deg = -1: must be in [0, 45]");
   t = TrialConfig{};
+  t.online.look_then_fly = true;
+  t.online.look_fallback_floor = 100.0;
+  EXPECT_EQ(invalidArgument(t),
+            "look_fallback_floor > 0: needs look_fallback = true (the search is made again before the fallback)");
+  t.online.look_fallback = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t.online.look_fallback_floor = 150.0;
+  EXPECT_EQ(invalidArgument(t), "look_fallback_floor = 150: must be below look_min_detections");
+  t = TrialConfig{};
   t.online.look_hold_margin = 0.2;
   EXPECT_EQ(invalidArgument(t),
             "look_hold_margin > 0: needs look_then_fly = true (it is asked of the views the explorer stops at)");

@@ -462,6 +462,30 @@ TEST(OnlineTrial, LookFallbackFliesTheRouteWhereTheLastFailedLookWouldEndTheTria
   EXPECT_EQ(fallback[2]["look_seen"], -1);  // flown as planned
 }
 
+TEST(OnlineTrial, ALowerFallbackFloorFliesALookRatedAtItBeforeTheRoute) {
+  // The fallback test's trial (no view meets the floor of 10000) with trial.look_fallback_floor 1:
+  // the plan that would end the trial searches again at that floor and flies what it finds there,
+  // a look or the way to the goal, not the route unrated.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall +
+                           " --set trial.max_flight_s=10 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=10000 --set trial.look_fallback=true";
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.look_fallback_floor=1 --out " + (dir / "lowered").string())).rc, 0);
+  const nlohmann::json plans = readJson(dir / "lowered/online.json")["plans"];
+  ASSERT_GE(plans.size(), 3U);
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::cout << "[ figure   ] plan at " << plans[i]["t_s"] << " s: ok " << plans[i]["ok"] << ", lowered "
+              << plans[i]["look_lowered"] << ", floor " << plans[i]["look_floor"] << ", fallback "
+              << plans[i]["look_fallback"] << "\n";
+    EXPECT_EQ(plans[i]["look_lowered"].get<bool>(), i == 2) << i;  // the first two hold, as without it
+    EXPECT_EQ(plans[i]["ok"].get<bool>(), i == 2) << i;
+    EXPECT_FALSE(plans[i]["look_fallback"].get<bool>()) << i;
+  }
+  EXPECT_EQ(plans[2]["look_floor"], 1.0);
+  EXPECT_EQ(plans[2]["look_pose"].size(), 4U);  // the search's path, not the route
+  EXPECT_TRUE(plans[2]["look_goal"].get<bool>() || plans[2]["look_seen"].get<int>() > 0);
+}
+
 TEST(OnlineTrial, LookStallFliesTheRouteWhereNoPlanHasComeCloserForAWhile) {
   // With a detection floor no view meets, the look search never finds a look and the vehicle holds:
   // no plan's route gets shorter. With trial.look_stall_s 3, the first plan 3 s after the first
