@@ -35,10 +35,9 @@ struct CellSight {
 // LookSearch's on_way_).
 enum class Tier : std::uint8_t { kAny = 0, kNear = 1, kWay = 2 };
 
-// A view from a cell (LookSearch::ratings).
+// A view from a cell (LookSearch::ratings): its shortfall, and the detections it expects.
 struct Rated {
-  float shortfall;
-  float detections;
+  float shortfall, detections;
 };
 
 // The search of planLook() over (cell, yaw) states: state = cell * yaws + yaw index.
@@ -350,8 +349,10 @@ class LookSearch {
     rateFrom(c);
     rated.resize(at(yaws_));
     for (int k = 0; k < yaws_; ++k) {
+      // A look guard's trip (GuardEvent::predicted) rules out views near the view ahead, not the held cell's.
       const bool ruled_out = std::any_of(tripped_.begin(), tripped_.end(), [&](const GuardEvent& e) {
-        return trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
+        return !(e.predicted() && cell == start_cell_) &&
+               trippedView(e, c, yawOf(k), config_.tripped_m, config_.half_hfov_rad);
       });
       const ViewRating r = rater_.rate(yawOf(k));
       rated[at(k)] = {ruled_out ? kRuledOut : static_cast<float>(r.shortfall), static_cast<float>(r.detections)};

@@ -432,6 +432,40 @@ TEST(LookThenFly, ViewsTheGuardTrippedOnAreRuledOutNearWhereItTripped) {
   }
 }
 
+// A look guard's trip (GuardEvent::predicted) rules out the view it foresaw ahead, near its apex,
+// not the cell the vehicle held in: from there the search turns and moves on. Ruling out the held
+// cell too, every move (its neighbours lie within tripped_m of the apex) and every turn (within
+// half the field of the trip's yaw) from the start was ruled out, and nothing was reached.
+TEST(LookThenFly, ALookGuardsTripLeavesTheHeldCellFreeToTurnAndMoveFrom) {
+  Room room(3.4);
+  GuardEvent ahead;
+  ahead.yaw_rad = ahead.good_yaw_rad = kStart.yaw_rad;
+  ahead.turning = false;
+  ahead.predicted_detections = 100.0;
+  ahead.wedge.apex = kStart.p_WB + Eigen::Vector3d(0.2, 0.0, 0.0);  // 0.2 m ahead, toward the wall
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {ahead}};
+  const LookPlan plan = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(), memory, config());
+  ASSERT_GE(plan.path.size(), 2U);
+  EXPECT_GT(plan.states, 1);
+  for (std::size_t i = 1; i < plan.path.size(); ++i) {
+    const planner::Pose4& p = plan.path[i];
+    const bool held_cell = (p.p_WB - kStart.p_WB).head<2>().norm() < 1e-9;
+    EXPECT_TRUE(held_cell ||
+                !trippedView(ahead, p.p_WB.head<2>(), p.yaw_rad, config().tripped_m, config().half_hfov_rad))
+        << p.p_WB.transpose() << " yaw " << p.yaw_rad;
+  }
+  // The same trip by the tracking guard (not foreseen) still rules out the held cell's views: the
+  // inliers said the view there was not trackable.
+  GuardEvent still = ahead;
+  still.predicted_detections = -1.0;
+  const LookPlan boxed = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(),
+                                  LookMemory{{kStart.p_WB}, {}, {}, {still}}, config());
+  std::cout << "[ figure   ] after a look guard's trip 0.2 m ahead: " << plan.states << " states, look at ("
+            << plan.path.back().p_WB.x() << ", " << plan.path.back().p_WB.y()
+            << "); after the same trip not foreseen: " << boxed.states << " states\n";
+  EXPECT_EQ(boxed.states, 1);
+}
+
 TEST(LookThenFly, TheLooksStallWhereNoRouteHasBeenHalfAMetreShorterForAWhile) {
   RouteProgress progress(0.5);
   EXPECT_EQ(progress.note(4.0, 12.0), 0.0);    // the first plan: progress from here
