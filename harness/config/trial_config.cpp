@@ -125,6 +125,9 @@ void OnlineConfig::validateLooks() const {
     throw std::invalid_argument(
         "look_hold_margin > 0: needs look_then_fly = true (it is asked of the views the explorer stops at)");
   }
+  if (look_along && !look_then_fly) {
+    throw std::invalid_argument("look_along = true: needs look_then_fly = true (it orders the explorer's looks)");
+  }
 }
 
 void OnlineConfig::validate() const {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <queue>
 #include <utility>
 
@@ -137,25 +138,16 @@ class LookSearch {
       });
       if (!flown) f = s;
     }
-    std::vector<std::pair<double, Eigen::Vector2d>> along;  // (distance along the route, point)
-    double d = 0.0;
-    for (std::size_t i = 0; i < route.size(); ++i) {
-      const Eigen::Vector2d p = route[i].head<2>();
-      if (i > 0) {
-        const Eigen::Vector2d q = route[i - 1].head<2>();
-        const int n = std::max(1, static_cast<int>(std::ceil((p - q).norm() / (0.5 * config_.cell_m))));
-        for (int k = 1; k <= n; ++k) along.emplace_back(d + (p - q).norm() * k / n, q + (p - q) * k / n);
-        d += (p - q).norm();
-      } else {
-        along.emplace_back(0.0, p);
-      }
-    }
-    for (auto it = along.rbegin(); it != along.rend() && it->first >= min_m; ++it) {
+    const RouteStations along(route, 0.5 * config_.cell_m);
+    for (auto it = along.stations().rbegin(); it != along.stations().rend() && it->first >= min_m; ++it) {
       const int cell = cellAt(it->second);
       if (cell >= 0 && first[at(cell)] >= 0) return first[at(cell)];
     }
     return -1;
   }
+
+  // LookConfig::along: chooseLook() orders its looks by how far along `route` their cells lie.
+  void orderAlong(const std::vector<Eigen::Vector3d>& route) { along_.emplace(route, 0.5 * config_.cell_m); }
 
   // The look pose among the states reached (planLook()) whose view observes at least min_seen
   // unknown columns of `tier` (out->seen); -1: none. markWay() first.
@@ -172,16 +164,19 @@ class LookSearch {
     }
     if (best <= 0 || best < min_seen) return -1;
     // The nearest that sees at least half as much as the best (and min_seen); at equal cost, the one
-    // that sees more.
+    // that sees more. With LookConfig::along, the one farthest along the route first (in cells).
     int chosen = -1;
+    long chosen_bin = 0;
     for (std::size_t n = 0; n < settled_.size(); ++n) {
       if (2 * seen[n] < best || seen[n] < min_seen) continue;
       const double c = cost_[at(settled_[n])];
-      if (chosen >= 0) {
+      const long bin = along_ ? std::lround(std::floor(along_->along(place(settled_[n] / yaws_)) / config_.cell_m)) : 0;
+      if (chosen >= 0 && bin <= chosen_bin) {
         const double c0 = cost_[at(settled_[at(chosen)])];
-        if (c > c0 + 1e-9 || (c >= c0 - 1e-9 && seen[n] <= seen[at(chosen)])) continue;
+        if (bin < chosen_bin || c > c0 + 1e-9 || (c >= c0 - 1e-9 && seen[n] <= seen[at(chosen)])) continue;
       }
       chosen = static_cast<int>(n);
+      chosen_bin = bin;
     }
     out->seen = seen[at(chosen)];
     return settled_[at(chosen)];
@@ -438,6 +433,7 @@ class LookSearch {
   std::vector<double> cost_;               // per state
   std::vector<int> prev_;                  // per state
   std::vector<int> settled_;               // in order of cost
+  std::optional<RouteStations> along_;     // LookConfig::along (none: the nearest look)
   int cells_rated_ = 0;
 };
 
@@ -462,6 +458,7 @@ LookPlan planLook(const planner::VoxelMap& voxels, ViewRater& rater, const plann
   int probe_from = -1;  // LookConfig::probe: the state reached that turns to the probed view
   if (!out.goal) {
     search.markWay(way_on);
+    if (config.along) search.orderAlong(route);
     // With advance, a look must observe at least the robot's footprint of unknown columns: less
     // opens no way for it.
     const double footprint = M_PI * config.robot_radius_m * config.robot_radius_m;

@@ -76,6 +76,11 @@ struct LookConfig {
   // its view while the next plan is made, must expect at least the floor in force times (1 +
   // hold_margin) detections; the views on the way there, the floor. 0: the floor.
   double hold_margin = 0.0;
+  // trial.look_along: of the looks that qualify (at least half the unknown columns the best one
+  // observes), the one whose cell lies farthest along the route (the planner's, up to the way on;
+  // by its nearest point, in cells), then the nearest. false: the nearest. The nearest crept: on
+  // gallery the explorer looked again every 0.4 m while the way on lay metres ahead.
+  bool along = false;
 };
 
 struct LookPlan {

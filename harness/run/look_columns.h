@@ -118,6 +118,44 @@ class LookColumns {
   std::vector<std::uint8_t> given_up_;
 };
 
+// Points along a route's horizontal polyline, at most step_m apart, each with its distance along
+// the route from its first point (LookConfig::advance and LookConfig::along).
+class RouteStations {
+ public:
+  RouteStations(const std::vector<Eigen::Vector3d>& route, double step_m) {
+    double d = 0.0;
+    for (std::size_t i = 0; i < route.size(); ++i) {
+      const Eigen::Vector2d p = route[i].head<2>();
+      if (i == 0) {
+        stations_.emplace_back(0.0, p);
+        continue;
+      }
+      const Eigen::Vector2d q = route[i - 1].head<2>();
+      const int n = std::max(1, static_cast<int>(std::ceil((p - q).norm() / step_m)));
+      for (int k = 1; k <= n; ++k) stations_.emplace_back(d + (p - q).norm() * k / n, q + (p - q) * k / n);
+      d += (p - q).norm();
+    }
+  }
+  // (distance along the route, point), from the first point on.
+  const std::vector<std::pair<double, Eigen::Vector2d>>& stations() const { return stations_; }
+  // The distance along the route of the station nearest p (the first of equals; 0: no route).
+  double along(const Eigen::Vector2d& p) const {
+    double nearest = std::numeric_limits<double>::infinity();
+    double d = 0.0;
+    for (const auto& [at, q] : stations_) {
+      const double r = (q - p).squaredNorm();
+      if (r < nearest) {
+        nearest = r;
+        d = at;
+      }
+    }
+    return d;
+  }
+
+ private:
+  std::vector<std::pair<double, Eigen::Vector2d>> stations_;
+};
+
 // trial.look_give_up: per unknown column, how many adopted looks were to observe it
 // (LookPlan::watched), and the columns counted often enough to give up (LookMemory::given_up).
 class LookWatch {

@@ -27,6 +27,7 @@ LookConfig OnlinePlanning::lookConfig(const Scenario& from_here, double clear_m)
   look.probe = cfg_.look_probe;
   look.floor_inliers = cfg_.guard_inliers;
   look.hold_margin = cfg_.look_hold_margin;
+  look.along = cfg_.look_along;
   if (cfg_.look_calibrate_floor && last_inliers_ >= cfg_.guard_inliers) look.tracked_inliers = last_inliers_;
   return look;
 }

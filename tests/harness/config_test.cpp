@@ -456,6 +456,11 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_hold_margin = std::nan("");
   EXPECT_EQ(invalidArgument(t), "look_hold_margin = nan: must be in [0, 10]");
   t = TrialConfig{};
+  t.online.look_along = true;
+  EXPECT_EQ(invalidArgument(t), "look_along = true: needs look_then_fly = true (it orders the explorer's looks)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
   t.online.look_guard = true;
   const std::string look_guard_needs =
       "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)";

@@ -366,6 +366,52 @@ TEST(LookThenFly, TheViewALookStopsAtExpectsTheHoldMarginOverTheFloor) {
             << " m)\n";
 }
 
+// LookConfig::along: of the looks that qualify, the one farthest along the route, not the nearest.
+TEST(LookThenFly, TheLookAlongTheRouteIsTheFarthestThatQualifies) {
+  Room room(3.4);
+  const LookMemory memory{{kStart.p_WB}, {}, {}, {}};
+  // The route east through the observed room, then north into the unknown way on.
+  const std::vector<Eigen::Vector3d> route{kStart.p_WB, Eigen::Vector3d(2.5, 0.0, kHeight),
+                                           Eigen::Vector3d(2.5, 1.0, kHeight)};
+  const RouteStations stations(route, 0.1);
+  const auto alongEnd = [&](const LookPlan& plan) { return stations.along(plan.path.back().p_WB.head<2>()); };
+  const LookPlan nearest = planLook(room.voxels, room.rater, kStart, kNorthGoal, route, northWayOn(), memory, config());
+  LookConfig c = config();
+  c.along = true;
+  const LookPlan along = planLook(room.voxels, room.rater, kStart, kNorthGoal, route, northWayOn(), memory, c);
+  ASSERT_GE(nearest.path.size(), 2U);
+  ASSERT_GE(along.path.size(), 2U);
+  EXPECT_TRUE(nearest.way);
+  EXPECT_TRUE(along.way);
+  // Farther along the route, at a greater cost, still seeing at least half as much.
+  EXPECT_GT(alongEnd(along), alongEnd(nearest) + c.cell_m);
+  EXPECT_GT(along.cost_m, nearest.cost_m);
+  EXPECT_GE(2 * along.seen, nearest.seen);
+  for (const planner::Pose4& p : along.path) {
+    EXPECT_TRUE(observedFree(room.voxels, p.p_WB)) << p.p_WB.transpose();
+    room.rater.moveTo(p.p_WB);
+    EXPECT_EQ(room.rater.shortfall(p.yaw_rad), 0.0) << p.p_WB.transpose() << " yaw " << p.yaw_rad;
+  }
+  // Without a route, every look is as far along (0): the nearest, as without the option.
+  const LookPlan no_route = planLook(room.voxels, room.rater, kStart, kNorthGoal, {}, northWayOn(), memory, c);
+  ASSERT_FALSE(no_route.path.empty());
+  EXPECT_EQ(no_route.path.back().p_WB, nearest.path.back().p_WB);
+  EXPECT_EQ(no_route.path.back().yaw_rad, nearest.path.back().yaw_rad);
+  std::cout << "[ figure   ] the nearest look ends " << alongEnd(nearest) << " m along the route (cost "
+            << nearest.cost_m << " m, " << nearest.seen << " columns), the look along it " << alongEnd(along)
+            << " m (cost " << along.cost_m << " m, " << along.seen << " columns)\n";
+}
+
+TEST(LookThenFly, RouteStationsMeasureTheDistanceAlongTheRouteOfItsNearestPoint) {
+  const RouteStations stations({Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 0, 1), Eigen::Vector3d(1, 2, 1)}, 0.25);
+  ASSERT_EQ(stations.stations().size(), 13U);  // 1 + 4 + 8
+  EXPECT_DOUBLE_EQ(stations.stations().back().first, 3.0);
+  EXPECT_DOUBLE_EQ(stations.along(Eigen::Vector2d(0.5, -0.3)), 0.5);
+  EXPECT_DOUBLE_EQ(stations.along(Eigen::Vector2d(1.4, 1.0)), 2.0);
+  EXPECT_DOUBLE_EQ(stations.along(Eigen::Vector2d(5.0, 5.0)), 3.0);
+  EXPECT_DOUBLE_EQ(RouteStations({}, 0.25).along(Eigen::Vector2d(1.0, 1.0)), 0.0);
+}
+
 TEST(LookThenFly, FindsNothingWhereNoViewIsTrackable) {
   Room bare(3.4, false);
   const Eigen::Vector3d goal(2.5, 3.5, kHeight);
