@@ -128,6 +128,9 @@ void OnlineConfig::validateLooks() const {
   if (look_along && !look_then_fly) {
     throw std::invalid_argument("look_along = true: needs look_then_fly = true (it orders the explorer's looks)");
   }
+  if (look_classes && !look_then_fly) {
+    throw std::invalid_argument("look_classes = true: needs look_then_fly = true (it widens the explorer's search)");
+  }
 }
 
 void OnlineConfig::validate() const {

@@ -171,6 +171,14 @@ struct OnlineConfig {
   // planner's route, then the nearest. false: the nearest. On gallery seed 2 the explorer looked
   // again every 0.4 m for 25 s while the views it chose watched the way on 5-10 m ahead.
   bool look_along = false;
+  // With look_then_fly (the proposed planner): where the search on the chosen class's route finds
+  // neither a view of its way on nor an advance along it, the other classes' routes are searched,
+  // in the planner's order of cost, and the first that has either is flown (online.json:
+  // look_class), before any look near the way on or at any unknown space. false: the choice's
+  // route alone. On gallery the explorer went back and forth for 300-400 s in the east corridor
+  // between advances along a class whose way on no trackable view observed and looks at unknown
+  // space behind it.
+  bool look_classes = false;
   // With look_then_fly, a goal-directed order of looks (LookConfig::advance): a look must observe
   // the robot's footprint of unknown space; where none observes the way on, the vehicle flies along
   // the route's observed part as far as the search reaches, and only then looks near the way on, then
@@ -330,6 +338,7 @@ struct OnlineConfig {
     a("look_fov_margin_deg", look_fov_margin_deg);
     a("look_hold_margin", look_hold_margin);
     a("look_along", look_along);
+    a("look_classes", look_classes);
     a("look_advance", look_advance);
     a("look_give_up", look_give_up);
     a("look_probe", look_probe);

@@ -2,6 +2,7 @@
 // where the plan's route runs into unknown space, the look search's flight to a trackable view of
 // the way on, in place of the route, and what the flight's looks leave for the next ones.
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -61,6 +62,9 @@ bool OnlinePlanning::lookFirst(const Scenario& from_here, const planner::Feature
                       &a->record);
   };
   LookPlan found = search(cfg_.look_min_detections);
+  if (cfg_.look_classes && !all_observed && !found.goal && !found.way && !found.advance && !found.probe) {
+    otherClassLook(from_here, map, rule, memory, look, &found, a);
+  }
   // A route all observed that the search cannot fly with trackable views: flown as planned.
   if (all_observed && !found.goal) {
     a->record.look_cells = found.cells;
@@ -140,6 +144,47 @@ LookPlan OnlinePlanning::searchLook(const planner::VoxelMap& voxels, const plann
     record->look_whole_fov = true;
   }
   return found;
+}
+
+void OnlinePlanning::otherClassLook(const Scenario& from_here, const planner::FeatureMap& map, const StopRule& rule,
+                                    const LookMemory& memory, const LookConfig& look, LookPlan* found,
+                                    Attempt* a) const {
+  const planner::Plan& plan = a->run.plan;
+  std::vector<std::size_t> order;
+  for (std::size_t k = 0; k < plan.candidates.size(); ++k) {
+    const planner::CandidatePath& c = plan.candidates[k];
+    if (static_cast<int>(k) != plan.chosen && c.feasible && c.path.size() >= 2 && std::isfinite(c.cost)) {
+      order.push_back(k);
+    }
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t i, std::size_t j) { return plan.candidates[i].cost < plan.candidates[j].cost; });
+  int cells = found->cells;
+  for (const std::size_t k : order) {
+    const std::vector<planner::Pose4>& path = plan.candidates[k].path;
+    const std::size_t known = stopBeforeUnknown(path, map, visited_, rule).size();
+    if (known >= path.size()) continue;  // observed all the way: no way on to look at
+    std::vector<Eigen::Vector3d> route;
+    std::vector<Eigen::Vector3d> way_on;
+    for (std::size_t i = 0; i < path.size(); ++i) (i < known ? route : way_on).push_back(path[i].p_WB);
+    OnlinePlan rated;  // its look_path and look_whole_fov
+    LookPlan other = searchLook(*a->run.voxels, from_here.scene.start, route, way_on, false, memory, look,
+                                cfg_.look_min_detections, &rated);
+    cells += other.cells;
+    if (!other.way && !other.advance) continue;
+    *found = std::move(other);
+    a->record.look_class = static_cast<int>(k);
+    a->record.look_path = std::move(rated.look_path);
+    a->record.look_whole_fov = rated.look_whole_fov;
+    a->record.path.clear();
+    a->record.path_unknown.clear();
+    for (const planner::Pose4& p : path) {
+      a->record.path.push_back(p.p_WB);
+      a->record.path_unknown.push_back(!map.isKnown(p.p_WB));
+    }
+    break;
+  }
+  found->cells = cells;
 }
 
 void OnlinePlanning::noteLook(const Attempt& a) {

@@ -99,6 +99,9 @@ struct OnlinePlan {
   // ... trial.look_fov_margin_deg: the search with the margin found nothing to fly, and this one was
   // rated on the whole image (OnlinePlanning::searchLook)
   bool look_whole_fov = false;
+  // trial.look_classes: the candidate (index into the plan's classes) whose route the look was found
+  // on, where not the planner's choice (path is then that route); -1: the choice's.
+  int look_class = -1;
   // ... where its path ends (x, y, z, yaw: the look pose, or the advance's; empty: none) and the
   // unknown columns that view is to observe (LookPlan::watched, their centres)
   std::vector<double> look_pose;
@@ -250,6 +253,13 @@ class OnlinePlanning {
                       const std::vector<Eigen::Vector3d>& route, const std::vector<Eigen::Vector3d>& way_on,
                       bool all_observed, const LookMemory& memory, const LookConfig& look, double min_detections,
                       OnlinePlan* record) const;
+  // trial.look_classes: where the search on the chosen class's route (*found) found neither a view
+  // of its way on nor an advance along it, the search on the other feasible candidates' routes that
+  // run into unknown space, in order of their cost; the first that finds either replaces *found
+  // (its cells count in found->cells either way), and the record says which (look_class) and takes
+  // its route (path, path_unknown, look_path, look_whole_fov).
+  void otherClassLook(const Scenario& from_here, const planner::FeatureMap& map, const StopRule& rule,
+                      const LookMemory& memory, const LookConfig& look, LookPlan* found, Attempt* a) const;
   // An adopted plan's look pose: not chosen again, and its columns counted (watch_), and its floor.
   void noteLook(const Attempt& a);
   // trial.look_guard at a tracked frame: true where it tripped (the vehicle holds, a plan is due).

@@ -229,6 +229,7 @@ nlohmann::ordered_json onlinePlansJson(const OnlineResult& online) {
     j["look_near"] = p.look_near;
     j["look_floor"] = p.look_floor;
     j["look_whole_fov"] = p.look_whole_fov;
+    j["look_class"] = p.look_class;
     j["look_pose"] = p.look_pose;
     nlohmann::ordered_json watched = nlohmann::ordered_json::array();
     for (const Eigen::Vector2d& c : p.look_watched) watched.push_back({c.x(), c.y()});

@@ -461,6 +461,11 @@ TEST(ConfigTrial, OnlineKeysAreValidatedWithFieldAndValue) {
   t.online.look_then_fly = true;
   EXPECT_EQ(invalidArgument(t), "");
   t = TrialConfig{};
+  t.online.look_classes = true;
+  EXPECT_EQ(invalidArgument(t), "look_classes = true: needs look_then_fly = true (it widens the explorer's search)");
+  t.online.look_then_fly = true;
+  EXPECT_EQ(invalidArgument(t), "");
+  t = TrialConfig{};
   t.online.look_guard = true;
   const std::string look_guard_needs =
       "look_guard = true: needs look_then_fly = true and guard_lead_s > 0 (it rates the look's view that far ahead)";

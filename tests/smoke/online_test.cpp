@@ -486,6 +486,46 @@ TEST(OnlineTrial, ALowerFallbackFloorFliesALookRatedAtItBeforeTheRoute) {
   EXPECT_TRUE(plans[2]["look_goal"].get<bool>() || plans[2]["look_seen"].get<int>() > 0);
 }
 
+TEST(OnlineTrial, LookClassesFliesALookAtTheWayOnOfAnotherClassWhereTheChoiceHasNone) {
+  // At a floor of 50 the second plan's choice (class 1) has no view of its way on and no advance:
+  // the vehicle looks near it. With trial.look_classes the search on the other class's route finds
+  // a view of that way on, and it is flown instead.
+  const auto dir = test::tempDir();
+  const std::string args = "--online --seed 3" + kSmall +
+                           " --set trial.max_flight_s=5 --set trial.look_then_fly=true"
+                           " --set trial.look_min_detections=50 --set trial.look_advance=true";
+  ASSERT_EQ(shell(trialCommand(args + " --out " + (dir / "choice").string())).rc, 0);
+  ASSERT_EQ(shell(trialCommand(args + " --set trial.look_classes=true --out " + (dir / "classes").string())).rc, 0);
+  const nlohmann::json choice = readJson(dir / "choice/online.json")["plans"];
+  const nlohmann::json classes = readJson(dir / "classes/online.json")["plans"];
+  ASSERT_GE(choice.size(), 2U);
+  ASSERT_GE(classes.size(), 2U);
+  for (const nlohmann::json& p : choice) EXPECT_EQ(p["look_class"], -1);
+  for (const nlohmann::json& p : classes) {
+    if (p["look_class"].get<int>() >= 0) {
+      EXPECT_TRUE(p["look_way"].get<bool>() || p["look_advance"].get<bool>());
+    }
+  }
+  EXPECT_EQ(classes[0]["look_class"], -1);  // at the start no class's route has a look: the same plan
+  EXPECT_EQ(classes[0]["look_cells"], choice[0]["look_cells"]);
+  const nlohmann::json& before = choice[1];
+  const nlohmann::json& after = classes[1];
+  std::cout << "[ figure   ] second plan: the choice (class " << before["chosen_class"] << ") looks near its way on ("
+            << before["look_seen"] << " columns, " << before["look_cells"] << " cells); with look_classes class "
+            << after["look_class"] << "'s way on (" << after["look_seen"] << " columns, " << after["look_cells"]
+            << " cells)\n";
+  EXPECT_TRUE(before["look_near"].get<bool>());
+  EXPECT_FALSE(before["look_way"].get<bool>());
+  EXPECT_FALSE(before["look_advance"].get<bool>());
+  EXPECT_EQ(after["chosen_class"], before["chosen_class"]);  // the planner chose the same
+  EXPECT_GE(after["look_class"].get<int>(), 0);
+  EXPECT_NE(after["look_class"], after["chosen_class"]);
+  EXPECT_TRUE(after["look_way"].get<bool>());
+  EXPECT_TRUE(after["adopted"].get<bool>());
+  EXPECT_GT(after["look_cells"].get<int>(), before["look_cells"].get<int>());  // both searches counted
+  EXPECT_NE(after["path"], before["path"]);                                    // the other class's route
+}
+
 TEST(OnlineTrial, LookStallFliesTheRouteWhereNoPlanHasComeCloserForAWhile) {
   // With a detection floor no view meets, the look search never finds a look and the vehicle holds:
   // no plan's route gets shorter. With trial.look_stall_s 3, the first plan 3 s after the first
